@@ -1,0 +1,188 @@
+// The operating-point state machine and its runner.
+#include "bench/point_procedure.hpp"
+
+#include <cmath>
+
+#include "drivers/error.hpp"
+
+namespace synbench::bench {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+PointProcedure::PointProcedure(drivers::BenchDevices devices, PointRequest request,
+                               PointOptions options)
+    : dev_(devices), req_(request), opt_(options), gate_(options.gate) {
+  record_.speed_rpm = req_.speed_rpm;
+  record_.load_Nm = req_.load_Nm;
+  record_.angle_deg = req_.angle_deg;
+  record_.estimator = req_.estimator;
+  record_.pwm = req_.pwm;
+}
+
+bool PointProcedure::check(std::error_code ec, const char* what) {
+  if (!ec) return true;
+  error_ = std::string(what) + ": " + ec.message();
+  phase_ = PointPhase::failed;
+  return false;
+}
+
+void PointProcedure::enter(PointPhase p, double now_s) {
+  phase_ = p;
+  t_phase_ = now_s;
+}
+
+void PointProcedure::begin_stop(double now_s) {
+  // Ordered stop, step one: the load first, so the SynRM is never driven by the load.
+  dev_.load->set_torque_Nm(0.0);
+  enter(PointPhase::stop, now_s);
+}
+
+void PointProcedure::tick(double now_s) {
+  if (finished()) return;
+  drivers::SynrmTelemetry st;
+  drivers::LoadTelemetry lt;
+  if (phase_ != PointPhase::start) {
+    if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
+    if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
+    const auto fault = st.fault != drivers::Fault::none ? st.fault : lt.fault;
+    if (fault != drivers::Fault::none && phase_ != PointPhase::stop) {
+      record_.fault = std::string(drivers::fault_name(fault));
+      error_ = "fault latched during the point: " + *record_.fault;
+      begin_stop(now_s);
+      return;
+    }
+  }
+
+  switch (phase_) {
+    case PointPhase::start: {
+      t_start_ = now_s;
+      if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
+      if (st.fault != drivers::Fault::none) {
+        error_ = "SynRM drive has a latched fault (" + std::string(drivers::fault_name(st.fault)) +
+                 "); reset it first";
+        phase_ = PointPhase::failed;
+        return;
+      }
+      if (!check(dev_.load->set_torque_Nm(0.0), "setting load torque")) return;
+      if (!check(dev_.load->enable(true), "enabling the load drive")) return;
+      if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
+      if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
+      if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+      if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
+      if (!check(dev_.synrm->enable(true), "enabling the SynRM drive")) return;
+      enter(PointPhase::spin_up, now_s);
+      return;
+    }
+    case PointPhase::spin_up: {
+      const bool reached = std::fabs(st.speed_rpm - req_.speed_rpm) < opt_.speed_reached_band_rpm;
+      if (reached || now_s - t_phase_ > opt_.spin_up_timeout_s) {
+        if (!reached) record_.unstable = true;
+        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        enter(PointPhase::load_up, now_s);
+      }
+      return;
+    }
+    case PointPhase::load_up: {
+      if (std::fabs(lt.torque_Nm - req_.load_Nm) < 0.02 * req_.load_Nm + 0.02 ||
+          now_s - t_phase_ > opt_.spin_up_timeout_s) {
+        gate_.reset();
+        enter(PointPhase::settle, now_s);
+      }
+      return;
+    }
+    case PointPhase::settle: {
+      gate_.add(now_s, st.speed_rpm, st.im_A, st.pac_W);
+      const bool settled = now_s - t_phase_ >= opt_.min_settle_s && gate_.steady();
+      const bool timed_out = now_s - t_phase_ > opt_.settle_timeout_s;
+      if (settled || timed_out) {
+        if (timed_out && !settled) record_.unstable = true;
+        if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
+        t_window_ = now_s;
+        record_.settle_s = now_s - t_start_;
+        enter(PointPhase::measure, now_s);
+      }
+      return;
+    }
+    case PointPhase::measure: {
+      if (!dev_.trigger->window_closed()) return;
+      read_results();
+      if (phase_ == PointPhase::failed) return;
+      if (opt_.ordered_stop_after) {
+        begin_stop(now_s);
+      } else {
+        enter(PointPhase::done, now_s);
+      }
+      return;
+    }
+    case PointPhase::stop: {
+      // Step two once the load torque is gone: speed to zero; step three: disable.
+      const bool timed_out = now_s - t_phase_ > opt_.stop_timeout_s;
+      if (lt.torque_Nm < 0.05 || timed_out) dev_.synrm->set_speed_rpm(0.0);
+      if ((std::fabs(st.speed_rpm) < opt_.stop_speed_rpm && lt.torque_Nm < 0.05) || timed_out ||
+          st.state == drivers::DriveState::faulted) {
+        dev_.synrm->enable(false);
+        dev_.load->enable(false);
+        phase_ = error_.empty() ? PointPhase::done : PointPhase::failed;
+      }
+      return;
+    }
+    case PointPhase::done:
+    case PointPhase::failed:
+      return;
+  }
+}
+
+void PointProcedure::read_results() {
+  drivers::SynrmWindow w;
+  drivers::LoadWindow lw;
+  drivers::MeterReading m;
+  if (!check(dev_.synrm->read_window(w), "reading the SynRM drive window")) return;
+  if (!check(dev_.load->read_window(lw), "reading the load drive window")) return;
+  if (!check(dev_.meter->read(m), "reading the power meter")) return;
+  auto& r = record_;
+  r.speed_meas_rpm = w.speed_meas_rpm;
+  r.im_A = w.im_A;
+  r.id_A = w.id_A;
+  r.iq_A = w.iq_A;
+  r.ud_V = w.ud_V;
+  r.uq_V = w.uq_V;
+  r.udc_V = w.udc_V;
+  r.idcm_A = m.idcm_A;
+  r.idcg_A = m.idcg_A;
+  r.pdcm_W = r.udc_V * m.idcm_A;
+  r.pdcg_W = r.udc_V * m.idcg_A;
+  const double wm = w.speed_meas_rpm * 2.0 * kPi / 60.0;
+  r.pm_W = lw.torque_Nm * wm + opt_.load_b1_Nms_per_rad * wm * wm;
+  r.efficiency = r.pdcm_W > 0 ? r.pm_W / r.pdcm_W : 0.0;
+  r.pos_err_min_deg = w.pos_err_min_deg;
+  r.pos_err_mean_deg = w.pos_err_mean_deg;
+  r.pos_err_max_deg = w.pos_err_max_deg;
+  r.speed_err_rpm = w.speed_err_rpm;
+  r.ld_est_H = w.ld_est_H;
+  r.lq_est_H = w.lq_est_H;
+  r.rs_est_ohm = w.rs_est_ohm;
+  r.temp_C = w.temp_C;
+  r.window_s = m.gate_s > 0 ? m.gate_s : w.window_s;
+  r.samples = w.samples;
+  r.voltage_limited = w.voltage_limited_fraction > 0;
+  if (w.fault != drivers::Fault::none) r.fault = std::string(drivers::fault_name(w.fault));
+  if (dev_.truth) r.truth = dev_.truth->read_truth_window();
+  has_record_ = true;
+}
+
+PointProcedure run_point(drivers::BenchDevices devices, drivers::Clock& clock,
+                         const PointRequest& request, const PointOptions& options) {
+  PointProcedure proc(devices, request, options);
+  double next = clock.now_s();
+  while (!proc.finished()) {
+    proc.tick(clock.now_s());
+    next += options.tick_s;
+    clock.wait_until(next);
+  }
+  return proc;
+}
+
+}  // namespace synbench::bench

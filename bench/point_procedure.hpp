@@ -1,0 +1,75 @@
+// One operating point as a state machine ticked with the current time: command the drives,
+// spin up, apply the load, wait for steady state, measure one window on every instrument at
+// once, record, and end with the ordered stop (load torque to zero, then speed, then disable).
+// It never sleeps; run_point() below is the loop that waits on a Clock.
+#pragma once
+
+#include <string>
+#include <system_error>
+
+#include "bench/point_record.hpp"
+#include "bench/steady_state.hpp"
+#include "drivers/clock.hpp"
+#include "drivers/devices.hpp"
+
+namespace synbench::bench {
+
+struct PointRequest {
+  double speed_rpm = 0;
+  double load_Nm = 0;
+  double angle_deg = 45;
+  drivers::Estimator estimator = drivers::Estimator::encoder;
+  drivers::Pwm pwm = drivers::Pwm::capwm;
+  double window_s = 1.0;
+};
+
+struct PointOptions {
+  double tick_s = 0.01;                 // how often the bench reads telemetry
+  double min_settle_s = 0.5;            // after the load is applied, before the gate may pass
+  double settle_timeout_s = 30.0;       // then the point is measured anyway and flagged unstable
+  double spin_up_timeout_s = 30.0;
+  double speed_reached_band_rpm = 5.0;
+  double stop_speed_rpm = 20.0;         // below this the drives are disabled
+  double stop_timeout_s = 30.0;
+  double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
+  bool ordered_stop_after = true;
+  SteadyStateBands gate;
+};
+
+enum class PointPhase { start, spin_up, load_up, settle, measure, stop, done, failed };
+
+class PointProcedure {
+ public:
+  PointProcedure(drivers::BenchDevices devices, PointRequest request, PointOptions options);
+
+  void tick(double now_s);
+  PointPhase phase() const { return phase_; }
+  bool finished() const { return phase_ == PointPhase::done || phase_ == PointPhase::failed; }
+  // Set once the window was measured (also when the point was unstable or limited).
+  bool has_record() const { return has_record_; }
+  const PointRecord& record() const { return record_; }
+  // Why the procedure failed: which device call and what it said.
+  const std::string& error() const { return error_; }
+
+ private:
+  bool check(std::error_code ec, const char* what);
+  void begin_stop(double now_s);
+  void read_results();
+  void enter(PointPhase p, double now_s);
+
+  drivers::BenchDevices dev_;
+  PointRequest req_;
+  PointOptions opt_;
+  SteadyStateGate gate_;
+  PointPhase phase_ = PointPhase::start;
+  double t_start_ = 0, t_phase_ = 0, t_window_ = 0;
+  bool has_record_ = false;
+  PointRecord record_;
+  std::string error_;
+};
+
+// Runs the procedure to its end, waiting on `clock` between ticks.
+PointProcedure run_point(drivers::BenchDevices devices, drivers::Clock& clock,
+                         const PointRequest& request, const PointOptions& options);
+
+}  // namespace synbench::bench

@@ -1,0 +1,41 @@
+// One measured operating point, with the field names of experiment.md Sec. 2.5: the one schema
+// used by the JSON output, the database, CSV export and the REST API.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "drivers/devices.hpp"
+#include "drivers/modes.hpp"
+
+namespace synbench::bench {
+
+struct PointRecord {
+  // setpoints
+  double speed_rpm = 0, load_Nm = 0, angle_deg = 0;
+  drivers::Estimator estimator = drivers::Estimator::encoder;
+  drivers::Pwm pwm = drivers::Pwm::capwm;
+  // measured
+  double speed_meas_rpm = 0, im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0, udc_V = 0;
+  double idcm_A = 0, idcg_A = 0, pdcm_W = 0, pdcg_W = 0, pm_W = 0, efficiency = 0;
+  // estimator (empty where they do not apply)
+  std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
+  std::optional<double> ld_est_H, lq_est_H, rs_est_ohm, ld_err_pct, lq_err_pct, rs_err_pct;
+  // conditions
+  double temp_C = 0, window_s = 0, settle_s = 0;
+  std::uint32_t samples = 0;
+  // flags
+  bool voltage_limited = false, unstable = false;
+  std::optional<std::string> fault;
+  // emulator only: the plant's own values over the window
+  std::optional<drivers::TruthWindow> truth;
+};
+
+nlohmann::ordered_json to_json(const PointRecord& r);
+// The same record for people: one "name  value" line per field.
+std::string to_text(const PointRecord& r);
+
+}  // namespace synbench::bench

@@ -1,0 +1,127 @@
+// Typed device interfaces of the bench: the SynRM drive, the PMSM load drive, the VFC power
+// meter, and the trigger that opens one measurement window on all of them at once. Real
+// inverters (through device profiles and Modbus) and the twin implement the same interfaces, as
+// ros2_control's mock and real hardware share one.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <system_error>
+
+#include "drivers/fault.hpp"
+#include "drivers/modes.hpp"
+
+namespace synbench::drivers {
+
+enum class DriveState : std::uint16_t { disabled = 0, running = 1, stopping = 2, faulted = 3 };
+
+// Filtered live values of the SynRM drive (controller frame for d, q).
+struct SynrmTelemetry {
+  double speed_rpm = 0;
+  double im_A = 0;
+  double id_A = 0;
+  double iq_A = 0;
+  double ud_V = 0;
+  double uq_V = 0;
+  double udc_V = 0;
+  double pac_W = 0;  // 1.5 (ud id + uq iq): the drive's own estimate of its output power
+  double temp_C = 0;
+  bool voltage_limited = false;
+  DriveState state = DriveState::disabled;
+  Fault fault = Fault::none;
+};
+
+// Results of one measurement window, accumulated by the drive at its control rate.
+struct SynrmWindow {
+  std::uint32_t samples = 0;
+  double window_s = 0;
+  double speed_meas_rpm = 0;  // from encoder counts over the window
+  double im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0, udc_V = 0, temp_C = 0;
+  double voltage_limited_fraction = 0;
+  // Estimator outputs; empty when the position source is the encoder.
+  std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
+  std::optional<double> ld_est_H, lq_est_H, rs_est_ohm;
+  Fault fault = Fault::none;  // fault latched during the window, if any
+};
+
+class SynrmDrive {
+ public:
+  virtual ~SynrmDrive() = default;
+  virtual std::error_code enable(bool on) = 0;
+  virtual std::error_code set_speed_rpm(double speed_rpm) = 0;
+  virtual std::error_code set_angle_deg(double angle_deg) = 0;
+  virtual std::error_code set_pwm(Pwm pwm) = 0;
+  virtual std::error_code set_estimator(Estimator estimator) = 0;
+  virtual std::error_code reset_fault() = 0;
+  virtual std::error_code read(SynrmTelemetry& out) = 0;
+  // The result of the last closed window; errc::not_ready while it is open.
+  virtual std::error_code read_window(SynrmWindow& out) = 0;
+};
+
+struct LoadTelemetry {
+  double torque_Nm = 0;  // braking torque magnitude from the measured current
+  double iq_A = 0;
+  DriveState state = DriveState::disabled;
+  Fault fault = Fault::none;
+};
+
+struct LoadWindow {
+  std::uint32_t samples = 0;
+  double torque_Nm = 0;
+};
+
+class LoadDrive {
+ public:
+  virtual ~LoadDrive() = default;
+  virtual std::error_code enable(bool on) = 0;
+  // Braking torque magnitude; the drive applies it against the direction of rotation.
+  virtual std::error_code set_torque_Nm(double torque_Nm) = 0;
+  virtual std::error_code reset_fault() = 0;
+  virtual std::error_code read(LoadTelemetry& out) = 0;
+  virtual std::error_code read_window(LoadWindow& out) = 0;
+};
+
+// VFC counts of the two DC-bus currents over the gate, and the currents the meter derives.
+struct MeterReading {
+  std::uint64_t counts_m = 0;
+  std::uint64_t counts_g = 0;
+  double gate_s = 0;
+  double idcm_A = 0;
+  double idcg_A = 0;
+};
+
+class PowerMeter {
+ public:
+  virtual ~PowerMeter() = default;
+  virtual std::error_code read(MeterReading& out) = 0;
+};
+
+// Opens one window on every device at once (hardware: a broadcast or a trigger line).
+class WindowTrigger {
+ public:
+  virtual ~WindowTrigger() = default;
+  virtual std::error_code open_window(double window_s) = 0;
+  virtual bool window_closed() = 0;
+};
+
+// The plant's own values over the last window; only a twin can offer them.
+struct TruthWindow {
+  double pin_W = 0, pcu_W = 0, pfe_W = 0, pmech_W = 0, pinvm_W = 0, pm_W = 0, temp_C = 0;
+};
+
+class TruthProbe {
+ public:
+  virtual ~TruthProbe() = default;
+  virtual std::optional<TruthWindow> read_truth_window() = 0;
+};
+
+// What the bench needs from the hardware layer, whatever implements it.
+struct BenchDevices {
+  SynrmDrive* synrm = nullptr;
+  LoadDrive* load = nullptr;
+  PowerMeter* meter = nullptr;
+  WindowTrigger* trigger = nullptr;
+  TruthProbe* truth = nullptr;  // null on real hardware
+};
+
+}  // namespace synbench::drivers

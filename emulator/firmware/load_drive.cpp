@@ -1,0 +1,75 @@
+// PMSM load drive firmware: ramped torque control, protection latch, window.
+#include "emulator/firmware/load_drive.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drivers/error.hpp"
+
+namespace synbench::emulator::firmware {
+
+LoadDriveFirmware::LoadDriveFirmware(const TwinConfig& config)
+    : cfg_(config), ts_(config.step_s()),
+      kt_(1.5 * config.load.pole_pairs * config.load.psi_pm_Wb) {
+  f_iq_.configure(config.firmware.telemetry_filter_s, ts_);
+}
+
+std::error_code LoadDriveFirmware::enable(bool on) {
+  if (!on) {
+    torque_cmd_Nm_ = 0;
+    if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
+    return {};
+  }
+  if (state_ == drivers::DriveState::faulted) return make_error_code(errc::device_fault);
+  state_ = drivers::DriveState::running;
+  return {};
+}
+
+std::error_code LoadDriveFirmware::set_torque_Nm(double torque_Nm) {
+  if (!std::isfinite(torque_Nm) || torque_Nm < 0 ||
+      torque_Nm > kt_ * cfg_.load.current_limit_A)
+    return make_error_code(errc::invalid_argument);
+  torque_set_Nm_ = torque_Nm;
+  return {};
+}
+
+std::error_code LoadDriveFirmware::reset_fault() {
+  if (state_ == drivers::DriveState::faulted) {
+    state_ = drivers::DriveState::disabled;
+    fault_ = drivers::Fault::none;
+  }
+  return {};
+}
+
+void LoadDriveFirmware::trip(drivers::Fault fault) {
+  if (state_ != drivers::DriveState::faulted) fault_ = fault;
+  state_ = drivers::DriveState::faulted;
+  torque_cmd_Nm_ = 0;
+}
+
+double LoadDriveFirmware::control(double iq_measured_A) {
+  if (state_ == drivers::DriveState::running) {
+    const double max_step = cfg_.load.torque_ramp_Nm_per_s * ts_;
+    torque_cmd_Nm_ += std::clamp(torque_set_Nm_ - torque_cmd_Nm_, -max_step, max_step);
+  } else {
+    torque_cmd_Nm_ = 0;
+  }
+  f_iq_.update(iq_measured_A);
+  if (window_left_ > 0) {
+    w_iq_.add(iq_measured_A);
+    if (--window_left_ == 0)
+      window_result_ = {static_cast<std::uint32_t>(w_iq_.count()), kt_ * w_iq_.mean()};
+  }
+  return torque_cmd_Nm_ / kt_;
+}
+
+void LoadDriveFirmware::begin_window(std::int64_t steps) {
+  window_left_ = steps;
+  w_iq_.reset();
+}
+
+drivers::LoadTelemetry LoadDriveFirmware::telemetry() const {
+  return {kt_ * f_iq_.value(), f_iq_.value(), state_, fault_};
+}
+
+}  // namespace synbench::emulator::firmware

@@ -1,0 +1,285 @@
+// SynRM drive firmware: FOC on the encoder, speed loop, protection, telemetry, window.
+#include "emulator/firmware/synrm_drive.hpp"
+
+#include <cmath>
+
+#include "drivers/error.hpp"
+
+namespace synbench::emulator::firmware {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRpmPerRadS = 60.0 / (2.0 * kPi);
+
+double wrap_pi(double x) {
+  x = std::fmod(x + kPi, 2.0 * kPi);
+  if (x < 0) x += 2.0 * kPi;
+  return x - kPi;
+}
+
+}  // namespace
+
+SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
+    : cfg_(config),
+      ts_(config.step_s()),
+      speed_divider_(static_cast<int>(std::lround(config.inverter.pwm_frequency_Hz /
+                                                  config.firmware.speed_loop_rate_Hz))),
+      pole_pairs_(config.synrm.pole_pairs),
+      counts_per_rev_(std::ldexp(1.0, config.encoder.resolution_bits)),
+      adc_lsb_A_(2.0 * config.firmware.adc_range_A / std::ldexp(1.0, config.firmware.adc_bits)),
+      flux_d_(config.synrm.flux_d),
+      flux_q_(config.synrm.flux_q),
+      rs_nominal_ohm_(config.synrm.rs_ohm),
+      dead_time_V_per_V_(config.inverter.dead_time_compensation
+                             ? config.inverter.dead_time_s * config.inverter.pwm_frequency_Hz
+                             : 0.0),
+      pwm_(config.firmware.pwm == "aspwm" ? drivers::Pwm::aspwm : drivers::Pwm::capwm) {
+  const auto& f = cfg_.firmware;
+  // Speed loop: crossover at the speed bandwidth for the bench inertia and the torque constant
+  // at rated current and 45 deg (from the drive's own flux maps), PI zero a quarter below.
+  const double i_rated = 2.26, c = std::sqrt(0.5) * i_rated;
+  const double kt = 1.5 * pole_pairs_ * (flux_d_.psi(c) * c - flux_q_.psi(c) * c) / i_rated;
+  const double ws = 2.0 * kPi * f.speed_bandwidth_Hz;
+  speed_kp_ = config.total_inertia_kgm2() * ws / kt;
+  speed_ki_ = speed_kp_ * ws / 4.0;
+  speed_pi_.set_gains(speed_kp_, speed_ki_);
+  speed_pi_.set_limits(-f.current_limit_A, f.current_limit_A);
+  // Tracking observer: critically damped at its bandwidth.
+  const double wo = 2.0 * kPi * f.speed_observer_bandwidth_Hz;
+  obs_kp_ = 2.0 * wo;
+  obs_ki_ = wo * wo;
+  for (LowPass* lp : {&f_speed_, &f_im_, &f_id_, &f_iq_, &f_ud_, &f_uq_, &f_udc_, &f_pac_, &f_temp_})
+    lp->configure(f.telemetry_filter_s, ts_);
+  f_udc_.reset(config.dc_bus.source_V);
+  f_temp_.reset(config.thermal.initial_C);
+}
+
+std::error_code SynrmDriveFirmware::enable(bool on) {
+  if (!on) {
+    gates_off();
+    if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
+    return {};
+  }
+  if (state_ == drivers::DriveState::faulted) return make_error_code(errc::device_fault);
+  if (state_ == drivers::DriveState::running) return {};
+  state_ = drivers::DriveState::running;
+  speed_ref_rpm_ = obs_omega_ * kRpmPerRadS;
+  speed_pi_.reset();
+  id_pi_.reset();
+  iq_pi_.reset();
+  return {};
+}
+
+std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
+  if (!std::isfinite(speed_rpm) || std::fabs(speed_rpm) > cfg_.firmware.max_speed_rpm)
+    return make_error_code(errc::invalid_argument);
+  speed_set_rpm_ = speed_rpm;
+  return {};
+}
+
+std::error_code SynrmDriveFirmware::set_angle_deg(double angle_deg) {
+  if (!std::isfinite(angle_deg) || angle_deg <= 0.0 || angle_deg >= 90.0)
+    return make_error_code(errc::invalid_argument);
+  angle_rad_ = angle_deg * kPi / 180.0;
+  return {};
+}
+
+std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {
+  pwm_ = pwm;
+  return {};
+}
+
+std::error_code SynrmDriveFirmware::set_estimator(drivers::Estimator estimator) {
+  // Sensorless estimators arrive with the estimator issue; the encoder is the only source yet.
+  return estimator == drivers::Estimator::encoder ? std::error_code{}
+                                                  : make_error_code(errc::not_supported);
+}
+
+std::error_code SynrmDriveFirmware::reset_fault() {
+  if (state_ == drivers::DriveState::faulted) {
+    state_ = drivers::DriveState::disabled;
+    fault_ = drivers::Fault::none;
+  }
+  return {};
+}
+
+void SynrmDriveFirmware::trip(drivers::Fault fault) {
+  if (state_ != drivers::DriveState::faulted) fault_ = fault;  // the first cause is kept
+  state_ = drivers::DriveState::faulted;
+  if (window_left_ > 0 && window_fault_ == drivers::Fault::none) window_fault_ = fault;
+  gates_off();
+}
+
+void SynrmDriveFirmware::gates_off() {
+  speed_pi_.reset();
+  id_pi_.reset();
+  iq_pi_.reset();
+  im_req_A_ = 0;
+  ud_ref_ = uq_ref_ = 0;
+}
+
+void SynrmDriveFirmware::check_protection(const DriveSample& s, double ia, double ib,
+                                          double speed_rpm) {
+  const auto& f = cfg_.firmware;
+  const double ic = -ia - ib;
+  const double i_peak = std::max({std::fabs(ia), std::fabs(ib), std::fabs(ic)});
+  if (i_peak > f.overcurrent_trip_A) return trip(drivers::Fault::overcurrent);
+  if (s.udc_V > f.overvoltage_trip_V) return trip(drivers::Fault::overvoltage);
+  if (std::fabs(speed_rpm) > f.overspeed_trip_rpm) return trip(drivers::Fault::overspeed);
+  if (s.temp_C > f.overtemp_trip_C) return trip(drivers::Fault::overtemperature);
+  if (state_ == drivers::DriveState::running && s.udc_V < f.undervoltage_trip_V)
+    return trip(drivers::Fault::undervoltage);
+}
+
+DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
+  ++step_;
+  // ADC: quantize the sampled phase currents.
+  const double ia = std::round(s.ia_A / adc_lsb_A_) * adc_lsb_A_;
+  const double ib = std::round(s.ib_A / adc_lsb_A_) * adc_lsb_A_;
+
+  // Encoder speed observer on the mechanical angle.
+  const double theta_m = static_cast<double>(s.encoder_count) * (2.0 * kPi / counts_per_rev_);
+  if (!observer_init_) {
+    obs_theta_ = theta_m;
+    observer_init_ = true;
+  }
+  const double e = theta_m - obs_theta_;  // multi-turn: no wrap needed
+  obs_omega_ += obs_ki_ * e * ts_;
+  obs_theta_ += (obs_omega_ + obs_kp_ * e) * ts_;
+  const double speed_rpm = obs_omega_ * kRpmPerRadS;
+
+  check_protection(s, ia, ib, speed_rpm);
+
+  const double theta_e = wrap_pi(pole_pairs_ * theta_m);
+  const double we = pole_pairs_ * obs_omega_;
+  const double ca = std::cos(theta_e), sa = std::sin(theta_e);
+  const double i_alpha = ia, i_beta = (ia + 2.0 * ib) / kSqrt3;  // Clarke with ic = -ia - ib
+  id_meas_ = ca * i_alpha + sa * i_beta;
+  iq_meas_ = -sa * i_alpha + ca * i_beta;
+
+  DriveOutput out;
+  out.pwm = pwm_;
+  limited_ = false;
+  if (state_ == drivers::DriveState::running) {
+    // Speed loop at its own rate, on a ramped reference.
+    if (step_ % static_cast<std::uint64_t>(speed_divider_) == 0) {
+      const double dt = ts_ * speed_divider_;
+      const double max_step = cfg_.firmware.speed_ramp_rpm_per_s * dt;
+      speed_ref_rpm_ += std::clamp(speed_set_rpm_ - speed_ref_rpm_, -max_step, max_step);
+      im_req_A_ = speed_pi_.update((speed_ref_rpm_ - speed_rpm) / kRpmPerRadS, dt);
+    }
+    // Motoring and braking both keep i_d positive; the sign of I_m goes to i_q (torque sign).
+    const double id_ref = std::fabs(im_req_A_) * std::cos(angle_rad_);
+    const double iq_ref = im_req_A_ * std::sin(angle_rad_);
+    const double wc = 2.0 * kPi * cfg_.firmware.current_bandwidth_Hz;
+    id_pi_.set_gains(wc * flux_d_.dynamic_inductance_H(id_ref), wc * rs_nominal_ohm_);
+    iq_pi_.set_gains(wc * flux_q_.dynamic_inductance_H(iq_ref), wc * rs_nominal_ohm_);
+    const double u_max = InverterModel::voltage_limit_V(s.udc_V);
+    id_pi_.set_limits(-u_max, u_max);
+    iq_pi_.set_limits(-u_max, u_max);
+    const bool hold = limited_hold_s_ > 0;
+    const double ud = id_pi_.update(id_ref - id_meas_, ts_, hold) - we * flux_q_.psi(iq_ref);
+    const double uq = iq_pi_.update(iq_ref - iq_meas_, ts_, hold) + we * flux_d_.psi(id_ref);
+    ud_ref_ = ud;
+    uq_ref_ = uq;
+    // Inverse Park at the angle the voltage will act at (one period of delay plus half a period).
+    const double th_out = theta_e + 1.5 * we * ts_;
+    const double co = std::cos(th_out), so = std::sin(th_out);
+    double ualpha = co * ud - so * uq, ubeta = so * ud + co * uq;
+    if (dead_time_V_per_V_ > 0) {
+      // Compensate the dead-time error with the direction of the reference phase currents.
+      const Phases iref = to_phases(co * id_ref - so * iq_ref, so * id_ref + co * iq_ref);
+      Phases comp;
+      for (int n = 0; n < 3; ++n)
+        comp[n] = dead_time_V_per_V_ * s.udc_V *
+                  std::clamp(iref[n] / cfg_.inverter.dead_time_current_band_A, -1.0, 1.0);
+      double ca2, cb2;
+      to_alpha_beta(comp, ca2, cb2);
+      ualpha += ca2;
+      ubeta += cb2;
+    }
+    const double mag = std::hypot(ualpha, ubeta);
+    if (mag > u_max) {
+      ualpha *= u_max / mag;
+      ubeta *= u_max / mag;
+      limited_ = true;
+    }
+    limited_hold_s_ = limited_ ? 0.01 : std::max(0.0, limited_hold_s_ - ts_);
+    out.gates_on = true;
+    out.ualpha_V = ualpha;
+    out.ubeta_V = ubeta;
+    out.duty = InverterModel::duties(ualpha, ubeta, s.udc_V);
+  }
+
+  const double im = std::hypot(id_meas_, iq_meas_);
+  f_speed_.update(speed_rpm);
+  f_im_.update(im);
+  f_id_.update(id_meas_);
+  f_iq_.update(iq_meas_);
+  f_ud_.update(ud_ref_);
+  f_uq_.update(uq_ref_);
+  f_udc_.update(s.udc_V);
+  f_pac_.update(1.5 * (ud_ref_ * id_meas_ + uq_ref_ * iq_meas_));
+  f_temp_.update(s.temp_C);
+  accumulate(s, im, id_meas_, iq_meas_, limited_);
+  return out;
+}
+
+void SynrmDriveFirmware::begin_window(std::int64_t steps) {
+  window_len_ = window_left_ = steps;
+  window_count_start_ = -1;
+  window_limited_ = 0;
+  window_fault_ = state_ == drivers::DriveState::faulted ? fault_ : drivers::Fault::none;
+  for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_}) w->reset();
+}
+
+void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, double iq,
+                                    bool limited) {
+  if (window_left_ <= 0) return;
+  if (window_count_start_ < 0) window_count_start_ = s.encoder_count;
+  w_im_.add(im);
+  w_id_.add(id);
+  w_iq_.add(iq);
+  w_ud_.add(ud_ref_);
+  w_uq_.add(uq_ref_);
+  w_udc_.add(s.udc_V);
+  w_temp_.add(s.temp_C);
+  window_limited_ += limited ? 1 : 0;
+  if (--window_left_ > 0) return;
+  drivers::SynrmWindow r;
+  r.samples = static_cast<std::uint32_t>(w_im_.count());
+  r.window_s = static_cast<double>(window_len_) * ts_;
+  // Encoder counts from the first to the last sample span samples - 1 periods.
+  const double span_s = static_cast<double>(r.samples > 1 ? r.samples - 1 : 1) * ts_;
+  r.speed_meas_rpm = static_cast<double>(s.encoder_count - window_count_start_) / counts_per_rev_ /
+                     span_s * 60.0;
+  r.im_A = w_im_.mean();
+  r.id_A = w_id_.mean();
+  r.iq_A = w_iq_.mean();
+  r.ud_V = w_ud_.mean();
+  r.uq_V = w_uq_.mean();
+  r.udc_V = w_udc_.mean();
+  r.temp_C = w_temp_.mean();
+  r.voltage_limited_fraction = static_cast<double>(window_limited_) / static_cast<double>(r.samples);
+  r.fault = state_ == drivers::DriveState::faulted ? fault_ : window_fault_;
+  window_result_ = r;
+}
+
+drivers::SynrmTelemetry SynrmDriveFirmware::telemetry() const {
+  drivers::SynrmTelemetry t;
+  t.speed_rpm = f_speed_.value();
+  t.im_A = f_im_.value();
+  t.id_A = f_id_.value();
+  t.iq_A = f_iq_.value();
+  t.ud_V = f_ud_.value();
+  t.uq_V = f_uq_.value();
+  t.udc_V = f_udc_.value();
+  t.pac_W = f_pac_.value();
+  t.temp_C = f_temp_.value();
+  t.voltage_limited = limited_hold_s_ > 0;
+  t.state = state_;
+  t.fault = fault_;
+  return t;
+}
+
+}  // namespace synbench::emulator::firmware

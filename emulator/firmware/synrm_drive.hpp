@@ -1,0 +1,104 @@
+// Firmware of the SynRM drive (physics.md 7): FOC with current loops every PWM period (40 Hz
+// bandwidth, gains scheduled on the dynamic inductance, flux-map decoupling, dead-time
+// compensation, SVM voltage limit with anti-windup), a 1 kHz speed loop (3 Hz) whose output is
+// I_m with the operator's current angle, protection trips that latch, telemetry filters, and
+// the measurement window accumulated at the control rate.
+#pragma once
+
+#include <cstdint>
+#include <system_error>
+
+#include "drivers/devices.hpp"
+#include "emulator/firmware/pi.hpp"
+#include "emulator/firmware/window_stats.hpp"
+#include "emulator/flux_map.hpp"
+#include "emulator/inverter_model.hpp"
+#include "emulator/twin_config.hpp"
+
+namespace synbench::emulator::firmware {
+
+// What the drive's ADCs and encoder interface see at the start of a PWM period.
+struct DriveSample {
+  double ia_A = 0, ib_A = 0;      // measured phase currents (noisy, quantized)
+  std::int64_t encoder_count = 0; // multi-turn encoder position
+  double udc_V = 0;
+  double temp_C = 0;
+};
+
+// What the drive commands for the next PWM period.
+struct DriveOutput {
+  bool gates_on = false;
+  double ualpha_V = 0, ubeta_V = 0;  // phase-voltage reference after limit and compensation
+  Phases duty{0.5, 0.5, 0.5};
+  drivers::Pwm pwm = drivers::Pwm::capwm;
+};
+
+class SynrmDriveFirmware {
+ public:
+  explicit SynrmDriveFirmware(const TwinConfig& config);
+
+  std::error_code enable(bool on);
+  std::error_code set_speed_rpm(double speed_rpm);
+  std::error_code set_angle_deg(double angle_deg);
+  std::error_code set_pwm(drivers::Pwm pwm);
+  std::error_code set_estimator(drivers::Estimator estimator);
+  std::error_code reset_fault();
+  // Latches a fault raised outside the control loop (watchdog, E-stop): gates off at once.
+  void trip(drivers::Fault fault);
+
+  DriveOutput control(const DriveSample& sample);
+
+  void begin_window(std::int64_t steps);
+  bool window_open() const { return window_left_ > 0; }
+  drivers::SynrmWindow window_result() const { return window_result_; }
+
+  drivers::SynrmTelemetry telemetry() const;
+  drivers::DriveState state() const { return state_; }
+  drivers::Fault fault() const { return fault_; }
+  drivers::Pwm pwm() const { return pwm_; }
+  double speed_reference_rpm() const { return speed_ref_rpm_; }
+
+ private:
+  void check_protection(const DriveSample& s, double ia, double ib, double speed_rpm);
+  void gates_off();
+  void accumulate(const DriveSample& s, double im, double id, double iq, bool limited);
+
+  TwinConfig cfg_;
+  double ts_;
+  int speed_divider_;
+  int pole_pairs_;
+  double counts_per_rev_;
+  double adc_lsb_A_;
+  FluxAxis flux_d_, flux_q_;
+  double rs_nominal_ohm_;
+  double dead_time_V_per_V_;  // dead-time voltage per volt of U_dc
+  double speed_kp_ = 0, speed_ki_ = 0;
+
+  drivers::DriveState state_ = drivers::DriveState::disabled;
+  drivers::Fault fault_ = drivers::Fault::none;
+  drivers::Pwm pwm_;
+  double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0;
+  std::uint64_t step_ = 0;
+
+  // Encoder speed observer (tracking PLL on the mechanical angle).
+  bool observer_init_ = false;
+  double obs_theta_ = 0, obs_omega_ = 0, obs_kp_ = 0, obs_ki_ = 0;
+
+  Pi speed_pi_, id_pi_, iq_pi_;
+  double im_req_A_ = 0;
+  double ud_ref_ = 0, uq_ref_ = 0, id_meas_ = 0, iq_meas_ = 0;
+  bool limited_ = false;
+
+  LowPass f_speed_, f_im_, f_id_, f_iq_, f_ud_, f_uq_, f_udc_, f_pac_, f_temp_;
+  double limited_hold_s_ = 0;
+
+  // Measurement window.
+  std::int64_t window_left_ = 0, window_len_ = 0;
+  std::int64_t window_count_start_ = 0;
+  long window_limited_ = 0;
+  drivers::Fault window_fault_ = drivers::Fault::none;
+  WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;
+  drivers::SynrmWindow window_result_;
+};
+
+}  // namespace synbench::emulator::firmware

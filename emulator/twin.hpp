@@ -1,0 +1,103 @@
+// The bench's twin: SynRM, PMSM load, shared DC bus, both inverters, VFC meter, MCIDC
+// measurement, thermal node and both drives' firmware, advanced together in fixed PWM periods
+// (100 us) on virtual time. The plant is integrated with Heun's method on flux linkage; the
+// drives see only what their sensors see (noisy quantized currents, encoder counts, U_dc).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "drivers/devices.hpp"
+#include "emulator/dc_bus.hpp"
+#include "emulator/firmware/load_drive.hpp"
+#include "emulator/firmware/synrm_drive.hpp"
+#include "emulator/inverter_model.hpp"
+#include "emulator/mcidc.hpp"
+#include "emulator/noise.hpp"
+#include "emulator/synrm_model.hpp"
+#include "emulator/thermal.hpp"
+#include "emulator/twin_config.hpp"
+#include "emulator/vfc_meter.hpp"
+
+namespace synbench::emulator {
+
+// Continuous states of the plant.
+struct PlantState {
+  double psi_d_Wb = 0, psi_q_Wb = 0;
+  double speed_rad_s = 0;  // mechanical
+  double angle_rad = 0;    // mechanical, multi-turn
+  double udc_V = 0;
+  double load_iq_A = 0;    // load drive's braking current (closed-loop response)
+};
+
+// Instantaneous plant values, for tests and the truth record.
+struct PlantSnapshot {
+  double id_A = 0, iq_A = 0, id0_A = 0, iq0_A = 0;
+  double torque_Nm = 0, load_torque_Nm = 0;
+  double speed_rpm = 0, udc_V = 0, temp_C = 0;
+  double ud_V = 0, uq_V = 0;  // terminal voltage in the true rotor frame
+  bool brake_on = false;
+};
+
+class Twin {
+ public:
+  explicit Twin(const TwinConfig& config);
+
+  void step();
+  void run_steps(std::int64_t n) {
+    for (std::int64_t i = 0; i < n; ++i) step();
+  }
+  double time_s() const { return static_cast<double>(steps_) * ts_; }
+  std::uint64_t steps() const { return steps_; }
+  double step_s() const { return ts_; }
+  const TwinConfig& config() const { return cfg_; }
+
+  firmware::SynrmDriveFirmware& synrm_drive() { return synrm_fw_; }
+  firmware::LoadDriveFirmware& load_drive() { return load_fw_; }
+
+  // Opens one window on the drives, the meter and the truth accumulator, starting at the next
+  // period and lasting round(window_s / step) periods on all of them.
+  void open_window(double window_s);
+  bool window_open() const { return window_pending_ > 0 || window_left_ > 0; }
+  const drivers::MeterReading& meter_reading() const { return vfc_.reading(); }
+  std::optional<drivers::TruthWindow> truth_window() const { return truth_; }
+
+  PlantSnapshot snapshot() const;
+  const PlantState& state() const { return x_; }
+  const SynrmModel& synrm_model() const { return synrm_; }
+  // The last MCIDC sample (none when the active vector was too short or the gates are off).
+  const std::optional<McidcSample>& mcidc_sample() const { return mcidc_sample_; }
+  bool mcidc_enabled = false;  // the estimators switch it on; it costs a Gaussian per period
+
+ private:
+  struct Rates;
+  Rates evaluate(const PlantState& x, double ua, double ub, bool gates, double rs,
+                 double load_iref, double p_inv_m, double p_inv_g) const;
+  double load_inverter_loss_W(const PlantState& x) const;
+
+  TwinConfig cfg_;
+  double ts_;
+  SynrmModel synrm_;
+  InverterModel inverter_;
+  DcBus bus_;
+  VfcMeter vfc_;
+  Mcidc mcidc_;
+  ThermalNode thermal_;
+  firmware::SynrmDriveFirmware synrm_fw_;
+  firmware::LoadDriveFirmware load_fw_;
+  Noise noise_;
+  double counts_per_rev_;
+  double load_kt_;
+
+  PlantState x_;
+  std::uint64_t steps_ = 0;
+  firmware::DriveOutput applied_;  // the command in force during this period
+  double load_iref_A_ = 0;
+  std::optional<McidcSample> mcidc_sample_;
+
+  std::int64_t window_pending_ = 0, window_left_ = 0;
+  double t_pin_ = 0, t_pcu_ = 0, t_pfe_ = 0, t_pmech_ = 0, t_pinv_ = 0, t_pm_ = 0, t_temp_ = 0;
+  std::optional<drivers::TruthWindow> truth_;
+};
+
+}  // namespace synbench::emulator

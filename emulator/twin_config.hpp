@@ -1,0 +1,142 @@
+// The twin's parameters: every physical constant of the emulated bench, in one struct tree.
+// Defaults are the thesis values (physics.md); values the thesis does not give are marked
+// [assumed] in the parameter table (twin_config_schema.cpp), which also validates and documents.
+#pragma once
+
+#include <string>
+
+namespace synbench::emulator {
+
+// Saturated flux linkage of one axis (thesis 1.22, Table 1.2).
+struct FluxAxisParams {
+  double l0_H = 0;      // unsaturated inductance
+  double psi0_Wb = 0;   // saturated-branch offset
+  double l1_H = 0;      // saturated-branch slope
+  double beta_WbA = 0;  // saturated-branch hyperbolic term (negative)
+};
+
+struct SynrmParams {
+  int pole_pairs = 2;
+  double rs_ohm = 9.68;
+  double rs_ref_temp_C = 50.0;
+  double rs_temp_coeff_per_K = 0.00393;
+  double inertia_kgm2 = 1.64e-3;
+  double b1_Nms_per_rad = 1.96e-3;
+  double b2_Nms2_per_rad2 = 1.0e-6;
+  FluxAxisParams flux_d{0.670, 1.30, 0.026, -0.647};
+  FluxAxisParams flux_q{0.382, 0.11, 0.081, -0.0085};
+  double core_kh_Ws_per_radWb2 = 0.03925;
+  double core_ke_Ws2_per_rad2Wb2 = 1.25e-4;
+};
+
+struct ThermalParams {
+  double capacity_J_per_K = 4000.0;
+  double resistance_K_per_W = 0.6;
+  double ambient_C = 25.0;
+  double initial_C = 50.0;
+};
+
+struct LoadParams {
+  int pole_pairs = 4;
+  double psi_pm_Wb = 0.15;
+  double rs_ohm = 1.2;
+  double ls_H = 5.0e-3;
+  double inertia_kgm2 = 2.0e-3;
+  double b1_Nms_per_rad = 2.0e-4;
+  double current_bandwidth_Hz = 200.0;
+  double current_limit_A = 10.0;
+  double torque_ramp_Nm_per_s = 10.0;
+};
+
+struct EncoderParams {
+  int resolution_bits = 12;
+};
+
+struct InverterParams {
+  double pwm_frequency_Hz = 10000.0;
+  double dead_time_s = 1.0e-6;
+  bool dead_time_compensation = true;
+  double dead_time_current_band_A = 0.05;
+  double vce0_V = 0.85;
+  double rce_ohm = 0.05;
+  double vf0_V = 0.95;
+  double rf_ohm = 0.07;
+  double esw0_J = 20.0e-6;
+  double esw_per_A_J = 40.0e-6;
+  double esw_ref_V = 400.0;
+};
+
+struct DcBusParams {
+  double source_V = 425.0;
+  double source_ohm = 2.0;
+  double capacitance_F = 1.0e-3;
+  double brake_on_V = 440.0;
+  double brake_off_V = 430.0;
+  double brake_ohm = 100.0;
+};
+
+struct VfcChannelErrors {
+  double gain_error = 0.0;      // relative error of the converter's true gain
+  double offset_error_A = 0.0;  // input-referred offset of the converter
+};
+
+struct VfcParams {
+  double f0_Hz = 500.0e3;
+  double kf_Hz_per_A = 100.0e3;
+  VfcChannelErrors motor;
+  VfcChannelErrors generator;
+};
+
+struct McidcParams {
+  double noise_sigma_per_H = 0.15;
+  double gain_error = 0.0;
+  double deformation_amplitude_per_H = 0.05;
+  int deformation_harmonic = 4;
+  double min_active_time_s = 10.0e-6;
+};
+
+struct FirmwareParams {
+  double current_bandwidth_Hz = 40.0;
+  double speed_bandwidth_Hz = 3.0;
+  double speed_loop_rate_Hz = 1000.0;
+  double speed_observer_bandwidth_Hz = 50.0;
+  double current_noise_sigma_A = 0.0158;
+  int adc_bits = 12;
+  double adc_range_A = 8.0;
+  double current_limit_A = 4.0;
+  double speed_ramp_rpm_per_s = 1000.0;
+  double telemetry_filter_s = 0.05;
+  double max_speed_rpm = 1500.0;
+  double overspeed_trip_rpm = 1800.0;
+  double overcurrent_trip_A = 6.0;
+  double overvoltage_trip_V = 450.0;
+  double undervoltage_trip_V = 300.0;
+  double overtemp_trip_C = 120.0;
+  std::string pwm = "capwm";
+};
+
+struct SimParams {
+  int seed_int = 1;  // noise generator seed
+};
+
+struct TwinConfig {
+  SynrmParams synrm;
+  ThermalParams thermal;
+  LoadParams load;
+  EncoderParams encoder;
+  InverterParams inverter;
+  DcBusParams dc_bus;
+  VfcParams vfc;
+  McidcParams mcidc;
+  FirmwareParams firmware;
+  SimParams sim;
+
+  double total_inertia_kgm2() const { return synrm.inertia_kgm2 + load.inertia_kgm2; }
+  double step_s() const { return 1.0 / inverter.pwm_frequency_Hz; }
+
+  // Operates the same bus design at another voltage: source voltage set to udc_V, chopper and
+  // over/under-voltage trips scaled in the same ratio (so a 560 V what-if bus does not trip).
+  void scale_bus_to(double udc_V);
+};
+
+}  // namespace synbench::emulator

@@ -1,0 +1,337 @@
+// Parameter table of the twin and the loader, validator and documenter driven by it.
+#include "emulator/twin_config_schema.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+namespace synbench::emulator {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct RowBuilder {
+  std::vector<ParamRow>& rows;
+  // Positive quantity from the thesis.
+  void pos(std::string key, double* f, std::string source, std::string doc, bool assumed = false) {
+    rows.push_back({std::move(key), f, 0, kInf, true, {}, assumed, std::move(source), std::move(doc)});
+  }
+  void num(std::string key, double* f, double lo, double hi, std::string source, std::string doc,
+           bool assumed = false) {
+    rows.push_back({std::move(key), f, lo, hi, false, {}, assumed, std::move(source), std::move(doc)});
+  }
+  void integer(std::string key, int* f, int lo, int hi, std::string source, std::string doc,
+               bool assumed = false) {
+    rows.push_back({std::move(key), f, double(lo), double(hi), false, {}, assumed, std::move(source),
+                    std::move(doc)});
+  }
+  void flag(std::string key, bool* f, std::string source, std::string doc, bool assumed = false) {
+    rows.push_back({std::move(key), f, 0, 0, false, {}, assumed, std::move(source), std::move(doc)});
+  }
+  void choice(std::string key, std::string* f, std::vector<std::string> choices, std::string source,
+              std::string doc) {
+    rows.push_back({std::move(key), f, 0, 0, false, std::move(choices), false, std::move(source),
+                    std::move(doc)});
+  }
+};
+
+constexpr bool A = true;  // marks an [assumed] value
+
+void flux_rows(RowBuilder& b, const std::string& axis, FluxAxisParams& p) {
+  const std::string k = "synrm.flux_" + axis + ".";
+  b.pos(k + "l0_H", &p.l0_H, "Table 1.2", "unsaturated inductance L" + axis + "0");
+  b.pos(k + "psi0_Wb", &p.psi0_Wb, "Table 1.2", "saturated branch offset Psi" + axis + "0");
+  b.pos(k + "l1_H", &p.l1_H, "Table 1.2", "saturated branch slope L" + axis + "1");
+  b.num(k + "beta_WbA", &p.beta_WbA, -kInf, 0, "Table 1.2",
+        "saturated branch hyperbolic term beta_" + axis + " (negative)");
+}
+
+}  // namespace
+
+ConfigError::ConfigError(std::string key, std::string reason)
+    : std::runtime_error("config key '" + key + "': " + reason), key_(std::move(key)),
+      reason_(std::move(reason)) {}
+
+std::vector<ParamRow> param_table(TwinConfig& c) {
+  std::vector<ParamRow> rows;
+  RowBuilder b{rows};
+  auto& m = c.synrm;
+  b.integer("synrm.pole_pairs", &m.pole_pairs, 1, 32, "Table 1.1", "pole pairs Pp");
+  b.pos("synrm.rs_ohm", &m.rs_ohm, "Table 1.1", "stator resistance at rs_ref_temp_C");
+  b.num("synrm.rs_ref_temp_C", &m.rs_ref_temp_C, -50, 200, "physics.md 1", "temperature at which rs_ohm holds");
+  b.num("synrm.rs_temp_coeff_per_K", &m.rs_temp_coeff_per_K, 0, 0.01, "copper", "Rs(T) = rs (1 + a (T - Tref))");
+  b.pos("synrm.inertia_kgm2", &m.inertia_kgm2, "Table 1.1", "SynRM rotor inertia J");
+  b.num("synrm.b1_Nms_per_rad", &m.b1_Nms_per_rad, 0, 1, "Table 1.1", "viscous friction B1 (coupled bench)");
+  b.num("synrm.b2_Nms2_per_rad2", &m.b2_Nms2_per_rad2, 0, 1, "assumed", "fan loss B2", A);
+  flux_rows(b, "d", m.flux_d);
+  flux_rows(b, "q", m.flux_q);
+  b.num("synrm.core_kh_Ws_per_radWb2", &m.core_kh_Ws_per_radWb2, 0, 10, "assumed",
+        "hysteresis term of P_Fe = (kh w_e + ke w_e^2) |Psi|^2", A);
+  b.num("synrm.core_ke_Ws2_per_rad2Wb2", &m.core_ke_Ws2_per_rad2Wb2, 0, 1, "assumed",
+        "eddy-current term of P_Fe", A);
+
+  auto& t = c.thermal;
+  b.pos("thermal.capacity_J_per_K", &t.capacity_J_per_K, "assumed", "thermal capacity C_th", A);
+  b.pos("thermal.resistance_K_per_W", &t.resistance_K_per_W, "assumed", "thermal resistance to ambient R_th", A);
+  b.num("thermal.ambient_C", &t.ambient_C, -40, 80, "assumed", "ambient temperature", A);
+  b.num("thermal.initial_C", &t.initial_C, -40, 150, "Sec. 6.3.2", "winding temperature at start (bench setpoint)");
+
+  auto& l = c.load;
+  b.integer("load.pole_pairs", &l.pole_pairs, 1, 32, "assumed", "PMSM pole pairs", A);
+  b.pos("load.psi_pm_Wb", &l.psi_pm_Wb, "assumed", "PMSM magnet flux", A);
+  b.pos("load.rs_ohm", &l.rs_ohm, "assumed", "PMSM stator resistance", A);
+  b.pos("load.ls_H", &l.ls_H, "assumed", "PMSM synchronous inductance", A);
+  b.pos("load.inertia_kgm2", &l.inertia_kgm2, "eq. 6.8", "PMSM inertia (J_tot = 3.64e-3 with the SynRM)");
+  b.num("load.b1_Nms_per_rad", &l.b1_Nms_per_rad, 0, 1, "assumed", "PMSM viscous friction B1G", A);
+  b.pos("load.current_bandwidth_Hz", &l.current_bandwidth_Hz, "assumed", "load drive current loop bandwidth", A);
+  b.pos("load.current_limit_A", &l.current_limit_A, "assumed", "load drive current limit", A);
+  b.pos("load.torque_ramp_Nm_per_s", &l.torque_ramp_Nm_per_s, "assumed", "load torque setpoint ramp", A);
+
+  b.integer("encoder.resolution_bits", &c.encoder.resolution_bits, 8, 24, "Sec. 6.1", "encoder resolution");
+
+  auto& i = c.inverter;
+  b.num("inverter.pwm_frequency_Hz", &i.pwm_frequency_Hz, 1000, 50000, "Sec. 6.1", "PWM frequency = simulation step rate");
+  b.num("inverter.dead_time_s", &i.dead_time_s, 0, 10e-6, "assumed", "dead time", A);
+  b.flag("inverter.dead_time_compensation", &i.dead_time_compensation, "Sec. 6.1", "dead-time compensation LUT on");
+  b.pos("inverter.dead_time_current_band_A", &i.dead_time_current_band_A, "assumed",
+        "current below which the dead-time error fades linearly to zero", A);
+  b.num("inverter.vce0_V", &i.vce0_V, 0, 5, "assumed", "IGBT on-state threshold voltage", A);
+  b.num("inverter.rce_ohm", &i.rce_ohm, 0, 5, "assumed", "IGBT on-state slope resistance", A);
+  b.num("inverter.vf0_V", &i.vf0_V, 0, 5, "assumed", "diode forward threshold voltage", A);
+  b.num("inverter.rf_ohm", &i.rf_ohm, 0, 5, "assumed", "diode slope resistance", A);
+  b.num("inverter.esw0_J", &i.esw0_J, 0, 1e-2, "assumed", "switching energy per on+off pair at zero current", A);
+  b.num("inverter.esw_per_A_J", &i.esw_per_A_J, 0, 1e-2, "assumed", "switching energy per ampere", A);
+  b.pos("inverter.esw_ref_V", &i.esw_ref_V, "assumed", "DC voltage at which the switching energies hold", A);
+
+  auto& d = c.dc_bus;
+  b.pos("dc_bus.source_V", &d.source_V, "assumed", "open-circuit voltage of the rectified supply", A);
+  b.pos("dc_bus.source_ohm", &d.source_ohm, "assumed", "source resistance", A);
+  b.pos("dc_bus.capacitance_F", &d.capacitance_F, "assumed", "bus capacitance", A);
+  b.pos("dc_bus.brake_on_V", &d.brake_on_V, "assumed", "brake chopper switches on above", A);
+  b.pos("dc_bus.brake_off_V", &d.brake_off_V, "assumed", "brake chopper switches off below", A);
+  b.pos("dc_bus.brake_ohm", &d.brake_ohm, "assumed", "braking resistor", A);
+
+  auto& v = c.vfc;
+  b.pos("vfc.f0_Hz", &v.f0_Hz, "assumed", "VFC frequency at zero current", A);
+  b.pos("vfc.kf_Hz_per_A", &v.kf_Hz_per_A, "assumed", "VFC gain", A);
+  b.num("vfc.motor.gain_error", &v.motor.gain_error, -0.5, 0.5, "assumed", "true/nominal gain - 1, I_dcM channel", A);
+  b.num("vfc.motor.offset_error_A", &v.motor.offset_error_A, -1, 1, "assumed", "input offset, I_dcM channel", A);
+  b.num("vfc.generator.gain_error", &v.generator.gain_error, -0.5, 0.5, "assumed", "true/nominal gain - 1, I_dcG channel", A);
+  b.num("vfc.generator.offset_error_A", &v.generator.offset_error_A, -1, 1, "assumed", "input offset, I_dcG channel", A);
+
+  auto& q = c.mcidc;
+  b.num("mcidc.noise_sigma_per_H", &q.noise_sigma_per_H, 0, 10, "eq. 6.4", "white noise of one R'_ph sample");
+  b.num("mcidc.gain_error", &q.gain_error, -0.5, 0.5, "assumed", "relative gain error delta_R", A);
+  b.num("mcidc.deformation_amplitude_per_H", &q.deformation_amplitude_per_H, 0, 10, "assumed",
+        "amplitude of the periodic deformation A_R (Figs. 6.6 to 6.8)", A);
+  b.integer("mcidc.deformation_harmonic", &q.deformation_harmonic, 0, 24, "assumed",
+            "harmonic order of A_R in (th_e + th_phN)", A);
+  b.num("mcidc.min_active_time_s", &q.min_active_time_s, 0, 50e-6, "assumed",
+        "shortest active vector whose current slope can be measured (CAPWM)", A);
+
+  auto& f = c.firmware;
+  b.pos("firmware.current_bandwidth_Hz", &f.current_bandwidth_Hz, "Sec. 6.1", "current loop bandwidth");
+  b.pos("firmware.speed_bandwidth_Hz", &f.speed_bandwidth_Hz, "Sec. 6.1", "speed loop bandwidth");
+  b.num("firmware.speed_loop_rate_Hz", &f.speed_loop_rate_Hz, 10, 10000, "Sec. 6.1", "speed loop rate");
+  b.pos("firmware.speed_observer_bandwidth_Hz", &f.speed_observer_bandwidth_Hz, "assumed",
+        "encoder speed tracking observer bandwidth", A);
+  b.num("firmware.current_noise_sigma_A", &f.current_noise_sigma_A, 0, 1, "eq. 6.5", "phase current noise");
+  b.integer("firmware.adc_bits", &f.adc_bits, 8, 24, "Sec. 6.1", "current ADC resolution");
+  b.pos("firmware.adc_range_A", &f.adc_range_A, "Sec. 6.1", "current ADC full scale (+/-)");
+  b.pos("firmware.current_limit_A", &f.current_limit_A, "assumed", "speed controller output limit (peak)", A);
+  b.pos("firmware.speed_ramp_rpm_per_s", &f.speed_ramp_rpm_per_s, "assumed", "speed setpoint ramp", A);
+  b.pos("firmware.telemetry_filter_s", &f.telemetry_filter_s, "assumed", "time constant of telemetry low-pass filters", A);
+  b.pos("firmware.max_speed_rpm", &f.max_speed_rpm, "Table 1.1", "largest speed setpoint accepted");
+  b.pos("firmware.overspeed_trip_rpm", &f.overspeed_trip_rpm, "assumed", "over-speed trip", A);
+  b.pos("firmware.overcurrent_trip_A", &f.overcurrent_trip_A, "assumed", "over-current trip (peak phase)", A);
+  b.pos("firmware.overvoltage_trip_V", &f.overvoltage_trip_V, "Sec. 6.1", "over-voltage trip (capacitor limit)");
+  b.pos("firmware.undervoltage_trip_V", &f.undervoltage_trip_V, "assumed", "under-voltage trip", A);
+  b.pos("firmware.overtemp_trip_C", &f.overtemp_trip_C, "assumed", "winding over-temperature trip", A);
+  b.choice("firmware.pwm", &f.pwm, {"capwm", "aspwm"}, "Sec. 5.2", "switching scheme at start");
+
+  rows.push_back({"sim.seed", &c.sim.seed_int, 0, 2147483647.0, false, {}, false, "-", "noise generator seed"});
+  return rows;
+}
+
+namespace {
+
+std::string describe_range(const ParamRow& r) {
+  std::ostringstream s;
+  s << (r.min_exclusive ? "(" : "[") << r.min << ", " << r.max << "]";
+  return s.str();
+}
+
+void set_row(const ParamRow& r, const nlohmann::json& v) {
+  std::visit(
+      [&](auto* f) {
+        using T = std::remove_pointer_t<decltype(f)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          if (!v.is_boolean()) throw ConfigError(r.key, "must be true or false");
+          *f = v.get<bool>();
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          if (!v.is_string()) throw ConfigError(r.key, "must be a string");
+          auto s = v.get<std::string>();
+          bool ok = r.choices.empty();
+          for (const auto& c : r.choices) ok = ok || c == s;
+          if (!ok) {
+            std::string list;
+            for (const auto& c : r.choices) list += (list.empty() ? "" : ", ") + c;
+            throw ConfigError(r.key, "'" + s + "' is not one of: " + list);
+          }
+          *f = s;
+        } else {
+          if (!v.is_number()) throw ConfigError(r.key, "must be a number");
+          const double x = v.get<double>();
+          if (!std::isfinite(x)) throw ConfigError(r.key, "must be finite");
+          if constexpr (std::is_same_v<T, int>) {
+            if (!v.is_number_integer()) throw ConfigError(r.key, "must be an integer");
+          }
+          const bool low = r.min_exclusive ? x <= r.min : x < r.min;
+          if (low || x > r.max) {
+            std::ostringstream s;
+            s << x << " is outside " << describe_range(r);
+            throw ConfigError(r.key, s.str());
+          }
+          *f = static_cast<T>(x);
+        }
+      },
+      r.field);
+}
+
+void walk(const nlohmann::json& node, const std::string& prefix,
+          const std::map<std::string, const ParamRow*>& rows) {
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    if (!it.key().empty() && it.key()[0] == '_') continue;
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (auto row = rows.find(key); row != rows.end()) {
+      set_row(*row->second, it.value());
+    } else if (it.value().is_object()) {
+      bool section = false;
+      for (const auto& [k, r] : rows) section = section || k.rfind(key + ".", 0) == 0;
+      if (!section) throw ConfigError(key, "unknown key");
+      walk(it.value(), key, rows);
+    } else {
+      throw ConfigError(key, "unknown key");
+    }
+  }
+}
+
+nlohmann::json row_value(const ParamRow& r) {
+  return std::visit([](auto* f) { return nlohmann::json(*f); }, r.field);
+}
+
+}  // namespace
+
+void apply_json(TwinConfig& config, const nlohmann::json& doc) {
+  if (!doc.is_object()) throw ConfigError("(root)", "must be a JSON object");
+  auto table = param_table(config);
+  std::map<std::string, const ParamRow*> rows;
+  for (const auto& r : table) rows[r.key] = &r;
+  walk(doc, "", rows);
+  validate(config);
+}
+
+TwinConfig load_twin_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError("(file)", "cannot open '" + path + "'");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw ConfigError("(file)", "'" + path + "' is not valid JSON: " + e.what());
+  }
+  TwinConfig config;
+  apply_json(config, doc);
+  return config;
+}
+
+void validate(const TwinConfig& c) {
+  if (c.dc_bus.brake_off_V >= c.dc_bus.brake_on_V)
+    throw ConfigError("dc_bus.brake_off_V", "must be below dc_bus.brake_on_V");
+  if (c.dc_bus.brake_on_V >= c.firmware.overvoltage_trip_V)
+    throw ConfigError("dc_bus.brake_on_V", "must be below firmware.overvoltage_trip_V");
+  if (c.firmware.undervoltage_trip_V >= c.dc_bus.source_V)
+    throw ConfigError("firmware.undervoltage_trip_V", "must be below dc_bus.source_V");
+  if (c.firmware.max_speed_rpm >= c.firmware.overspeed_trip_rpm)
+    throw ConfigError("firmware.max_speed_rpm", "must be below firmware.overspeed_trip_rpm");
+  if (c.firmware.current_limit_A >= c.firmware.overcurrent_trip_A)
+    throw ConfigError("firmware.current_limit_A", "must be below firmware.overcurrent_trip_A");
+  if (c.firmware.overcurrent_trip_A >= c.firmware.adc_range_A)
+    throw ConfigError("firmware.overcurrent_trip_A", "must be below firmware.adc_range_A");
+  if (c.firmware.speed_loop_rate_Hz > c.inverter.pwm_frequency_Hz)
+    throw ConfigError("firmware.speed_loop_rate_Hz", "must not exceed inverter.pwm_frequency_Hz");
+  const double ratio = c.inverter.pwm_frequency_Hz / c.firmware.speed_loop_rate_Hz;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9)
+    throw ConfigError("firmware.speed_loop_rate_Hz", "must divide inverter.pwm_frequency_Hz");
+  if (c.firmware.current_bandwidth_Hz * 10 > c.inverter.pwm_frequency_Hz)
+    throw ConfigError("firmware.current_bandwidth_Hz", "must be at most a tenth of the PWM frequency");
+  auto check_axis = [](const FluxAxisParams& p, const std::string& axis) {
+    // The two branches must cross (the switch point is their upper crossing).
+    const double a = p.l0_H - p.l1_H;
+    if (a <= 0) throw ConfigError("synrm.flux_" + axis + ".l1_H", "must be below l0_H");
+    if (p.psi0_Wb * p.psi0_Wb + 4 * a * p.beta_WbA < 0)
+      throw ConfigError("synrm.flux_" + axis + ".beta_WbA", "the saturated branch never meets the linear one");
+  };
+  check_axis(c.synrm.flux_d, "d");
+  check_axis(c.synrm.flux_q, "q");
+}
+
+nlohmann::json to_json(const TwinConfig& config) {
+  TwinConfig copy = config;
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& r : param_table(copy)) {
+    nlohmann::json::json_pointer ptr("/" + [&] {
+      std::string p = r.key;
+      for (auto& ch : p) if (ch == '.') ch = '/';
+      return p;
+    }());
+    out[ptr] = row_value(r);
+    if (r.assumed) {
+      const auto dot = r.key.rfind('.');
+      std::string section = r.key.substr(0, dot), leaf = r.key.substr(dot + 1);
+      std::string sp = "/" + section;
+      for (auto& ch : sp) if (ch == '.') ch = '/';
+      out[nlohmann::json::json_pointer(sp + "/_assumed")].push_back(leaf);
+    }
+  }
+  out["_comment"] = "synbench twin config. Defaults: thesis values; keys listed in a section's _assumed are our calibration, not from the thesis. See docs/emulator-config.md.";
+  return out;
+}
+
+std::string markdown_reference(const TwinConfig& config) {
+  TwinConfig copy = config;
+  std::ostringstream s;
+  s << "| key | default | valid | source | meaning |\n|---|---|---|---|---|\n";
+  for (const auto& r : param_table(copy)) {
+    std::string valid;
+    if (std::holds_alternative<bool*>(r.field)) {
+      valid = "true, false";
+    } else if (std::holds_alternative<std::string*>(r.field)) {
+      for (const auto& c : r.choices) valid += (valid.empty() ? "" : ", ") + c;
+    } else {
+      valid = describe_range(r);
+    }
+    s << "| `" << r.key << "` | " << row_value(r).dump() << " | " << valid << " | "
+      << (r.assumed ? "**[assumed]**" : r.source) << " | " << r.doc << " |\n";
+  }
+  return s.str();
+}
+
+}  // namespace synbench::emulator
+
+namespace synbench::emulator {
+
+void TwinConfig::scale_bus_to(double udc_V) {
+  const double k = udc_V / dc_bus.source_V;
+  dc_bus.source_V = udc_V;
+  dc_bus.brake_on_V *= k;
+  dc_bus.brake_off_V *= k;
+  firmware.overvoltage_trip_V *= k;
+  firmware.undervoltage_trip_V *= k;
+}
+
+}  // namespace synbench::emulator

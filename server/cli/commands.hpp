@@ -1,0 +1,16 @@
+// The synbench subcommands. Each takes its own arguments (after the subcommand name) and
+// returns the process exit status: 0 ok, 1 runtime failure, 2 bad usage, 3 faulted point.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace synbench::cli {
+
+int point_command(const std::vector<std::string>& args);
+int config_command(const std::vector<std::string>& args);
+
+extern const char* const kPointHelp;
+extern const char* const kConfigHelp;
+
+}  // namespace synbench::cli

@@ -1,0 +1,152 @@
+// `synbench point`: one operating point on the in-process twin, on virtual time.
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+
+#include "bench/point_procedure.hpp"
+#include "emulator/twin_bench.hpp"
+#include "emulator/twin_config_schema.hpp"
+#include "server/cli/args.hpp"
+#include "server/cli/commands.hpp"
+
+namespace synbench::cli {
+
+const char* const kPointHelp = R"(usage: synbench point --speed-rpm N --load-Nm T --angle-deg A [options]
+
+Runs one operating point on the in-process twin of the bench, on virtual time (as fast as the
+CPU allows): starts the drives, brings the bench to the point, waits for steady state, measures
+one window on every instrument at once, prints one record, and ends with the ordered stop.
+
+required:
+  --speed-rpm N      SynRM speed setpoint, 0 < N <= firmware.max_speed_rpm (1500)
+  --load-Nm T        PMSM braking torque, 0 <= T <= load limit
+  --angle-deg A      current angle in the controller's frame, 0 < A < 90
+
+options:
+  --pwm S            capwm (default) or aspwm
+  --estimator E      position source: encoder (default)
+  --udc-V V          DC-bus source voltage; chopper and trips scale with it (default 425)
+  --window-s S       measurement window (VFC gate), s (default 1)
+  --temp-C T         winding temperature at start (default 50, the bench setpoint)
+  --config FILE      twin config JSON (partial: overrides the defaults; see docs/emulator-config.md)
+  --seed N           noise seed (default from config)
+  --json             print the record as one JSON object (field names: docs/record.md)
+  --help             this text
+
+exit status: 0 measured, 1 failed, 2 bad input, 3 a fault latched during the point
+)";
+
+namespace {
+
+drivers::Pwm parse_pwm_flag(const std::optional<std::string>& s) {
+  if (!s) return drivers::Pwm::capwm;
+  if (auto p = drivers::parse_pwm(*s)) return *p;
+  throw UsageError("--pwm", "'" + *s + "' is not a PWM scheme (capwm, aspwm)");
+}
+
+drivers::Estimator parse_estimator_flag(const std::optional<std::string>& s) {
+  if (!s) return drivers::Estimator::encoder;
+  if (auto e = drivers::parse_estimator(*s)) return *e;
+  throw UsageError("--estimator", "'" + *s + "' is not an estimator");
+}
+
+double required(const Args& a, const std::string& flag) {
+  auto v = a.number(flag);
+  if (!v) throw UsageError(flag, "is required");
+  return *v;
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+int point_command(const std::vector<std::string>& argv) {
+  emulator::TwinConfig config;
+  bench::PointRequest req;
+  bool json = false;
+  try {
+    Args a(argv, {"--json", "--help"},
+           {"--speed-rpm", "--load-Nm", "--angle-deg", "--pwm", "--estimator", "--udc-V",
+            "--window-s", "--temp-C", "--config", "--seed"});
+    if (a.has("--help")) {
+      std::cout << kPointHelp;
+      return 0;
+    }
+    if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
+    json = a.has("--json");
+    if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+
+    req.speed_rpm = required(a, "--speed-rpm");
+    req.load_Nm = required(a, "--load-Nm");
+    req.angle_deg = required(a, "--angle-deg");
+    req.pwm = parse_pwm_flag(a.text("--pwm"));
+    req.estimator = parse_estimator_flag(a.text("--estimator"));
+    req.window_s = a.number("--window-s").value_or(1.0);
+
+    if (req.speed_rpm <= 0 || req.speed_rpm > config.firmware.max_speed_rpm)
+      throw UsageError("--speed-rpm", fmt(req.speed_rpm) + " is outside (0, " +
+                                          fmt(config.firmware.max_speed_rpm) +
+                                          "] rpm (firmware.max_speed_rpm)");
+    const double load_max = 1.5 * config.load.pole_pairs * config.load.psi_pm_Wb *
+                            config.load.current_limit_A;
+    if (req.load_Nm < 0 || req.load_Nm > load_max)
+      throw UsageError("--load-Nm", fmt(req.load_Nm) + " is outside [0, " + fmt(load_max) +
+                                        "] N m (the load drive's current limit)");
+    if (req.angle_deg <= 0 || req.angle_deg >= 90)
+      throw UsageError("--angle-deg", fmt(req.angle_deg) + " is outside (0, 90) deg");
+    if (req.window_s <= 0 || req.window_s > 3600)
+      throw UsageError("--window-s", fmt(req.window_s) + " is outside (0, 3600] s");
+    if (req.estimator != drivers::Estimator::encoder)
+      throw UsageError("--estimator", "'" + std::string(drivers::name(req.estimator)) +
+                                          "' is not available yet; only encoder");
+    if (auto udc = a.number("--udc-V")) {
+      if (*udc < 100 || *udc > 800)
+        throw UsageError("--udc-V", fmt(*udc) + " is outside [100, 800] V");
+      config.scale_bus_to(*udc);
+    }
+    if (auto t = a.number("--temp-C")) {
+      if (*t < -40 || *t >= config.firmware.overtemp_trip_C)
+        throw UsageError("--temp-C", fmt(*t) + " is outside [-40, " +
+                                         fmt(config.firmware.overtemp_trip_C) +
+                                         ") degC (firmware.overtemp_trip_C)");
+      config.thermal.initial_C = *t;
+    }
+    if (auto seed = a.number("--seed")) {
+      if (*seed < 0 || *seed > 2147483647 || *seed != std::floor(*seed))
+        throw UsageError("--seed", "must be a whole number in [0, 2147483647]");
+      config.sim.seed_int = static_cast<int>(*seed);
+    }
+  } catch (const UsageError& e) {
+    std::cerr << "synbench point: " << e.what() << "\n";
+    return 2;
+  } catch (const emulator::ConfigError& e) {
+    std::cerr << "synbench point: --config: " << e.what() << "\n";
+    return 2;
+  }
+
+  emulator::TwinBench bench(config);
+  bench::PointOptions options;
+  options.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
+  const auto proc = bench::run_point(bench.devices(), bench.clock(), req, options);
+  if (!proc.has_record()) {
+    std::cerr << "synbench point: " << proc.error() << "\n";
+    return 1;
+  }
+  if (json) {
+    std::cout << bench::to_json(proc.record()).dump() << "\n";
+  } else {
+    std::cout << "operating point (twin, " << bench.clock().now_s() << " s of bench time)\n"
+              << bench::to_text(proc.record());
+  }
+  if (proc.record().fault) {
+    std::cerr << "synbench point: " << proc.error() << "\n";
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace synbench::cli

@@ -1,0 +1,42 @@
+// synbench: one executable, one subcommand per job.
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "server/cli/commands.hpp"
+#include "synbench/version.hpp"
+
+namespace {
+
+const char* const kHelp = R"(usage: synbench <command> [options]
+
+synbench runs efficiency experiments on a synchronous reluctance motor test bench, or on its
+built-in twin.
+
+commands:
+  point     measure one operating point on the in-process twin
+  config    print or check the twin's configuration
+
+  synbench <command> --help    options of a command
+  synbench --version           version
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kHelp;
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] == "--version") {
+    std::cout << "synbench " << synbench::kVersion << "\n";
+    return 0;
+  }
+  const std::string command = args[0];
+  args.erase(args.begin());
+  if (command == "point") return synbench::cli::point_command(args);
+  if (command == "config") return synbench::cli::config_command(args);
+  std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
+  return 2;
+}
