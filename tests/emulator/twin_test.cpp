@@ -1,0 +1,83 @@
+// The twin as a device: windows cover exactly the gate, runs are reproducible, faults latch.
+#include "emulator/twin.hpp"
+
+#include <gtest/gtest.h>
+
+#include "drivers/error.hpp"
+#include "point_runner.hpp"
+
+namespace synbench {
+namespace {
+
+using testing::measure;
+
+TEST(Twin, WindowCoversExactlyTheGateOnEveryInstrument) {
+  const emulator::TwinConfig cfg;
+  const auto r = measure(cfg, 500, 1.5, 54, drivers::Pwm::capwm, 0.25);
+  EXPECT_EQ(r.samples, 2500u);
+  EXPECT_DOUBLE_EQ(r.window_s, 0.25);
+}
+
+TEST(Twin, SameSeedSameRecordOtherSeedOtherNoise) {
+  emulator::TwinConfig cfg;
+  const auto a = measure(cfg, 500, 1.5, 54);
+  const auto b = measure(cfg, 500, 1.5, 54);
+  EXPECT_EQ(a.pdcm_W, b.pdcm_W);
+  EXPECT_EQ(a.im_A, b.im_A);
+  cfg.sim.seed_int = 7;
+  const auto c = measure(cfg, 500, 1.5, 54);
+  EXPECT_NE(a.im_A, c.im_A);
+  // Repeatability of P_dcM far below the watts that separate configurations (experiment.md 4).
+  EXPECT_NEAR(a.pdcm_W, c.pdcm_W, 0.2);
+}
+
+TEST(Twin, ExternalTripLatchesUntilAnExplicitReset) {
+  const emulator::TwinConfig cfg;
+  emulator::TwinBench bench(cfg);
+  auto d = bench.devices();
+  ASSERT_FALSE(d.synrm->set_angle_deg(50));
+  ASSERT_FALSE(d.synrm->set_speed_rpm(900));
+  ASSERT_FALSE(d.synrm->enable(true));
+  bench.clock().wait_until(1.0);
+  drivers::SynrmTelemetry t;
+  ASSERT_FALSE(d.synrm->read(t));
+  EXPECT_EQ(t.state, drivers::DriveState::running);
+
+  // An external trip (E-stop) gates the drive off and latches.
+  bench.twin().synrm_drive().trip(drivers::Fault::estop);
+  bench.clock().wait_until(1.5);
+  ASSERT_FALSE(d.synrm->read(t));
+  EXPECT_EQ(t.state, drivers::DriveState::faulted);
+  EXPECT_EQ(t.fault, drivers::Fault::estop);
+  EXPECT_EQ(d.synrm->enable(true), make_error_code(errc::device_fault));
+  bench.clock().wait_until(3.0);
+  EXPECT_LT(bench.twin().snapshot().speed_rpm, 900.0) << "no torque while faulted";
+  EXPECT_NEAR(bench.twin().snapshot().iq_A, 0.0, 0.01);
+  ASSERT_FALSE(d.synrm->reset_fault());
+  ASSERT_FALSE(d.synrm->read(t));
+  EXPECT_EQ(t.state, drivers::DriveState::disabled) << "a reset does not restart";
+  EXPECT_FALSE(d.synrm->enable(true));
+}
+
+TEST(Twin, OvercurrentTripFromThePlant) {
+  emulator::TwinConfig cfg;
+  cfg.firmware.overcurrent_trip_A = 1.3;
+  cfg.firmware.current_limit_A = 1.25;
+  const auto r = measure(cfg, 900, 3.5, 56);
+  ASSERT_TRUE(r.fault);
+  EXPECT_EQ(*r.fault, "overcurrent");
+}
+
+TEST(Twin, WarmerWindingLosesMoreInCopper) {
+  emulator::TwinConfig cfg;
+  const auto cold = measure(cfg, 700, 2.5, 56);
+  cfg.thermal.initial_C = 70.0;
+  const auto hot = measure(cfg, 700, 2.5, 56);
+  ASSERT_TRUE(cold.truth && hot.truth);
+  // Rs(T) = Rs (1 + 0.00393 (T - 50)): 7.9 % more copper loss at 70 degC, same current.
+  EXPECT_NEAR(hot.truth->pcu_W / cold.truth->pcu_W, 1.0786, 0.01);
+  EXPECT_GT(hot.pdcm_W, cold.pdcm_W + 0.05 * cold.truth->pcu_W);
+}
+
+}  // namespace
+}  // namespace synbench
