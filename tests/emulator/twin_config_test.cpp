@@ -73,3 +73,21 @@ TEST(TwinConfig, BusScalingMovesChopperAndTrips) {
 
 }  // namespace
 }  // namespace synbench::emulator
+
+namespace synbench::emulator {
+namespace {
+
+TEST(TwinConfig, DocumentedTableIsTheGeneratedOne) {
+  std::ifstream in(std::string(SYNBENCH_SOURCE_DIR) + "/docs/emulator-config.md");
+  ASSERT_TRUE(in);
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string begin = "<!-- generated: synbench config --markdown -->\n";
+  const auto a = doc.find(begin), b = doc.find("<!-- end generated -->");
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_EQ(doc.substr(a + begin.size(), b - a - begin.size()), markdown_reference(TwinConfig{}))
+      << "regenerate the table in docs/emulator-config.md with `synbench config --markdown`";
+}
+
+}  // namespace
+}  // namespace synbench::emulator

@@ -1,0 +1,102 @@
+// A device profile: the data that maps the bench's logical signals of one device to Modbus
+// registers, so a user brings a drive by writing JSON rather than code. docs/device-profile.md
+// is the schema for those users; parse_device_profile is its one implementation.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drivers/profile/register_codec.hpp"
+#include "drivers/profile/signal_catalogue.hpp"
+
+namespace synbench::drivers {
+
+// The four Modbus tables.
+enum class RegisterKind { coil, discrete_input, holding, input };
+enum class Access { r, w, rw };
+
+std::string_view name(RegisterKind k);
+std::string_view name(Access a);
+std::optional<RegisterKind> parse_register_kind(std::string_view s);
+std::optional<Access> parse_access(std::string_view s);
+
+constexpr bool is_bit_kind(RegisterKind k) { return k == RegisterKind::coil || k == RegisterKind::discrete_input; }
+// Modbus can write coils and holding registers only.
+constexpr bool is_writable_kind(RegisterKind k) { return k == RegisterKind::coil || k == RegisterKind::holding; }
+
+// Watchdog timing carried by the heartbeat signal.
+struct HeartbeatTiming {
+  std::uint32_t period_ms = 0;   // how often the bench writes a new value
+  std::uint32_t timeout_ms = 0;  // how long the device waits for a change before it trips
+};
+
+// A named value of an enumerated signal (state, estimator, ...), in engineering units.
+struct EnumValue {
+  std::int64_t value = 0;
+  std::string label;
+};
+
+struct ProfileSignal {
+  std::string name;
+  SignalRole role = SignalRole::telemetry;
+  std::uint8_t unit_id = 1;
+  RegisterKind kind = RegisterKind::holding;
+  std::uint16_t address = 0;
+  RegisterEncoding encoding;  // type boolean for coils and discrete inputs; limits ±inf if absent
+  std::string unit;           // engineering unit, as in the signal's name; empty if dimensionless
+  Access access = Access::r;
+  std::vector<EnumValue> values;           // sorted by value; empty unless enumerated
+  std::optional<HeartbeatTiming> heartbeat;  // set on the heartbeat signal only
+
+  bool readable() const { return access != Access::w; }
+  bool writable() const { return access != Access::r; }
+  // Last address the signal occupies.
+  std::uint16_t last_address() const {
+    return static_cast<std::uint16_t>(address + address_width(encoding.type) - 1);
+  }
+};
+
+struct DeviceProfile {
+  std::string name;
+  std::string description;
+  DeviceKind kind = DeviceKind::synrm_drive;
+  std::uint8_t unit_id = 1;
+  std::vector<ProfileSignal> signals;  // ordered by register kind, unit id, address
+
+  const ProfileSignal* find(std::string_view signal) const;
+};
+
+// One validation problem: a JSON pointer into the profile document (RFC 6901, "" for the whole
+// document) and what is wrong there.
+struct ProfileError {
+  std::string path;
+  std::string reason;
+};
+
+// Every problem is reported, not only the first, so a user fixes a profile in one pass.
+struct ProfileParseResult {
+  std::optional<DeviceProfile> profile;  // set exactly when errors is empty
+  std::vector<ProfileError> errors;
+};
+
+ProfileParseResult parse_device_profile(const nlohmann::json& doc);
+
+// Reads and parses a profile file; unreadable files and JSON syntax errors are reported at
+// path "" with the file name in the reason.
+ProfileParseResult load_device_profile(const std::filesystem::path& file);
+
+// drivers/profiles/ of the source tree, where the profiles of synbench's own firmware live.
+std::filesystem::path default_profile_dir();
+// default_profile_dir() / "<kind>.json"
+std::filesystem::path default_profile_path(DeviceKind kind);
+
+// "a/b~c" -> "a~1b~0c": a signal name as one JSON pointer token.
+std::string json_pointer_token(std::string_view key);
+
+}  // namespace synbench::drivers

@@ -1,0 +1,124 @@
+// The signal catalogue. Required are the signals without which the bench cannot command a
+// device, keep it safe, or run a measurement window on it; everything else is optional, and a
+// driver answers errc::not_supported for an optional signal its profile leaves out.
+#include "drivers/profile/signal_catalogue.hpp"
+
+namespace synbench::drivers {
+namespace {
+
+using R = SignalRole;
+
+constexpr SignalSpec kSynrm[] = {
+    {"enable", R::command, true, "", "1 runs the drive, 0 ramps it down and disables it"},
+    {"speed_setpoint_rpm", R::command, true, "rpm", "speed reference"},
+    {"angle_setpoint_deg", R::command, true, "deg", "current-vector angle from the d axis"},
+    {"pwm_scheme", R::command, false, "", "0 capwm, 1 aspwm"},
+    {"estimator", R::command, false, "",
+     "position source: 0 encoder, 1 ekf-basic, 2 ekf-rs, 3 hfi, 4 eemf-const, 5 eemf-lut, 6 eemf-rls"},
+    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault"},
+    {"heartbeat", R::heartbeat, true, "",
+     "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
+     "has not changed for timeout_ms"},
+    {"window_start", R::window_start, true, "", "writing 1 opens a window of window_length_ms"},
+    {"window_length_ms", R::window_length, true, "ms", "length of the next window"},
+    {"state", R::telemetry, true, "", "0 disabled, 1 running, 2 stopping, 3 faulted"},
+    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp), 0 none"},
+    {"speed_rpm", R::telemetry, true, "rpm", "filtered speed"},
+    {"im_A", R::telemetry, false, "A", "current-vector magnitude"},
+    {"id_A", R::telemetry, false, "A", "d current"},
+    {"iq_A", R::telemetry, false, "A", "q current"},
+    {"ud_V", R::telemetry, false, "V", "d voltage"},
+    {"uq_V", R::telemetry, false, "V", "q voltage"},
+    {"udc_V", R::telemetry, false, "V", "DC-link voltage"},
+    {"pac_W", R::telemetry, false, "W", "the drive's estimate of its output power"},
+    {"temp_C", R::telemetry, false, "C", "power-stage temperature"},
+    {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
+    {"window_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
+    {"window_samples", R::window_result, true, "", "control periods accumulated"},
+    {"window_s", R::window_result, true, "s", "accumulated duration"},
+    {"window_fault_code", R::window_result, false, "", "fault latched during the window, 0 none"},
+    {"window_speed_meas_rpm", R::window_result, false, "rpm", "speed from encoder counts over the window"},
+    {"window_im_A", R::window_result, false, "A", "mean"},
+    {"window_id_A", R::window_result, false, "A", "mean"},
+    {"window_iq_A", R::window_result, false, "A", "mean"},
+    {"window_ud_V", R::window_result, false, "V", "mean"},
+    {"window_uq_V", R::window_result, false, "V", "mean"},
+    {"window_udc_V", R::window_result, false, "V", "mean"},
+    {"window_temp_C", R::window_result, false, "C", "mean"},
+    {"window_voltage_limited_fraction", R::window_result, false, "", "fraction of samples voltage-limited, 0..1"},
+    {"window_pos_err_min_deg", R::window_result, false, "deg", "estimator position error, minimum; not with the encoder"},
+    {"window_pos_err_mean_deg", R::window_result, false, "deg", "estimator position error, mean; not with the encoder"},
+    {"window_pos_err_max_deg", R::window_result, false, "deg", "estimator position error, maximum; not with the encoder"},
+    {"window_speed_err_rpm", R::window_result, false, "rpm", "estimator speed error, mean; not with the encoder"},
+    {"window_ld_est_H", R::window_result, false, "H", "estimated d inductance, mean; not with the encoder"},
+    {"window_lq_est_H", R::window_result, false, "H", "estimated q inductance, mean; not with the encoder"},
+    {"window_rs_est_ohm", R::window_result, false, "ohm", "estimated stator resistance, mean; not with the encoder"},
+};
+
+constexpr SignalSpec kLoad[] = {
+    {"enable", R::command, true, "", "1 runs the drive, 0 disables it"},
+    {"torque_setpoint_Nm", R::command, true, "Nm", "braking torque magnitude, applied against the rotation"},
+    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault"},
+    {"heartbeat", R::heartbeat, true, "",
+     "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
+     "has not changed for timeout_ms"},
+    {"window_start", R::window_start, false, "",
+     "writing 1 opens a window of window_length_ms; for a bench without a trigger line"},
+    {"window_length_ms", R::window_length, false, "ms", "length of the next window"},
+    {"state", R::telemetry, true, "", "0 disabled, 1 running, 2 stopping, 3 faulted"},
+    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp), 0 none"},
+    {"torque_Nm", R::telemetry, true, "Nm", "braking torque magnitude from the measured current"},
+    {"iq_A", R::telemetry, false, "A", "q current"},
+    {"window_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
+    {"window_samples", R::window_result, true, "", "control periods accumulated"},
+    {"window_torque_Nm", R::window_result, true, "Nm", "mean braking torque"},
+};
+
+constexpr SignalSpec kMeter[] = {
+    {"gate_start", R::window_start, true, "", "writing 1 opens a gate of gate_length_ms"},
+    {"gate_length_ms", R::window_length, true, "ms", "length of the next gate"},
+    {"gate_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"gate_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed gate"},
+    {"counts_m", R::window_result, true, "", "VFC pulses of the motor-side DC current over the gate"},
+    {"counts_g", R::window_result, true, "", "VFC pulses of the generator-side DC current over the gate"},
+    {"gate_s", R::window_result, true, "s", "measured gate duration"},
+    {"idcm_A", R::window_result, true, "A", "motor-side DC current, (counts_m / gate_s - f0_Hz) / kf_Hz_per_A"},
+    {"idcg_A", R::window_result, true, "A", "generator-side DC current, (counts_g / gate_s - f0_Hz) / kf_Hz_per_A"},
+    {"f0_Hz", R::calibration, false, "Hz", "nominal converter frequency at zero current"},
+    {"kf_Hz_per_A", R::calibration, false, "Hz/A", "nominal converter gain"},
+};
+
+constexpr std::array<std::string_view, 3> kKindNames{"synrm_drive", "load_drive", "vfc_meter"};
+constexpr std::array<std::string_view, 10> kRoleNames{
+    "command",       "heartbeat",       "fault_reset",   "window_start", "window_length",
+    "window_status", "window_sequence", "window_result", "telemetry",    "calibration"};
+
+}  // namespace
+
+std::string_view name(DeviceKind k) { return kKindNames[static_cast<std::size_t>(k)]; }
+std::string_view name(SignalRole r) { return kRoleNames[static_cast<std::size_t>(r)]; }
+
+std::optional<DeviceKind> parse_device_kind(std::string_view s) {
+  for (std::size_t i = 0; i < kKindNames.size(); ++i)
+    if (kKindNames[i] == s) return static_cast<DeviceKind>(i);
+  return std::nullopt;
+}
+
+std::span<const SignalSpec> signal_catalogue(DeviceKind k) {
+  switch (k) {
+    case DeviceKind::synrm_drive: return kSynrm;
+    case DeviceKind::load_drive: return kLoad;
+    case DeviceKind::vfc_meter: return kMeter;
+  }
+  return {};
+}
+
+const SignalSpec* find_signal_spec(DeviceKind k, std::string_view signal) {
+  for (const SignalSpec& s : signal_catalogue(k))
+    if (s.name == signal) return &s;
+  return nullptr;
+}
+
+}  // namespace synbench::drivers

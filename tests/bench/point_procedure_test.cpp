@@ -1,0 +1,72 @@
+// The point procedure on the twin: phases, settle time, unstable and faulted points, stop order.
+#include "bench/point_procedure.hpp"
+
+#include <gtest/gtest.h>
+
+#include "emulator/twin_bench.hpp"
+
+namespace synbench::bench {
+namespace {
+
+PointRequest request(double speed, double load, double angle) {
+  PointRequest r;
+  r.speed_rpm = speed;
+  r.load_Nm = load;
+  r.angle_deg = angle;
+  return r;
+}
+
+TEST(PointProcedure, MeasuresSettlesAndEndsStopped) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  const auto p = run_point(bench.devices(), bench.clock(), request(700, 2.5, 52), PointOptions{});
+  ASSERT_EQ(p.phase(), PointPhase::done) << p.error();
+  ASSERT_TRUE(p.has_record());
+  const auto& r = p.record();
+  EXPECT_FALSE(r.unstable);
+  EXPECT_FALSE(r.fault);
+  // Spin-up at 1000 rpm/s, load at 10 N m/s, at least 0.5 s settling: 1.2 s at the very least.
+  EXPECT_GT(r.settle_s, 1.2);
+  EXPECT_LT(r.settle_s, 6.0);
+  // Ordered stop: load torque gone, shaft (nearly) still, both drives disabled.
+  const auto snap = bench.twin().snapshot();
+  EXPECT_LT(snap.speed_rpm, 25.0);
+  EXPECT_NEAR(snap.load_torque_Nm, 0.0, 0.01);
+  EXPECT_EQ(bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+}
+
+TEST(PointProcedure, AnUnsettledPointIsMeasuredAndFlaggedNotDropped) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  PointOptions opt;
+  opt.gate.speed_band_rpm = 1e-6;  // unreachable
+  opt.settle_timeout_s = 1.0;
+  const auto p = run_point(bench.devices(), bench.clock(), request(500, 1.0, 56), opt);
+  ASSERT_TRUE(p.has_record());
+  EXPECT_TRUE(p.record().unstable);
+  EXPECT_GT(p.record().pdcm_W, 0.0);
+}
+
+TEST(PointProcedure, AFaultEndsThePointInTheOrderedStopAndIsRecorded) {
+  emulator::TwinConfig cfg;
+  cfg.firmware.overtemp_trip_C = 50.5;
+  cfg.thermal.initial_C = 50.4;
+  cfg.thermal.capacity_J_per_K = 20;  // heats in seconds
+  emulator::TwinBench bench(cfg);
+  const auto p = run_point(bench.devices(), bench.clock(), request(900, 3.5, 56), PointOptions{});
+  EXPECT_EQ(p.phase(), PointPhase::failed);
+  EXPECT_NE(p.error().find("overtemperature"), std::string::npos) << p.error();
+  EXPECT_EQ(p.record().fault.value_or(""), "overtemperature");
+  EXPECT_NEAR(bench.twin().snapshot().load_torque_Nm, 0.0, 0.01);
+  EXPECT_EQ(bench.twin().synrm_drive().state(), drivers::DriveState::faulted) << "latched";
+}
+
+TEST(PointProcedure, RefusesToStartOnALatchedFault) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  bench.twin().synrm_drive().trip(drivers::Fault::estop);
+  const auto p = run_point(bench.devices(), bench.clock(), request(500, 1.0, 56), PointOptions{});
+  EXPECT_EQ(p.phase(), PointPhase::failed);
+  EXPECT_FALSE(p.has_record());
+  EXPECT_NE(p.error().find("reset it first"), std::string::npos) << p.error();
+}
+
+}  // namespace
+}  // namespace synbench::bench

@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""The synbench command line as a user meets it: --version, --help, `point` records, and bad
+input rejected with exit status 2 and a message naming the flag (or config key)."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+BIN = sys.argv[1]
+RECORD_FIELDS = """speed_rpm load_Nm angle_deg estimator pwm speed_meas_rpm im_A id_A iq_A ud_V uq_V
+udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W efficiency pos_err_min_deg pos_err_mean_deg pos_err_max_deg
+speed_err_rpm ld_est_H lq_est_H rs_est_ohm ld_err_pct lq_err_pct rs_err_pct temp_C window_s samples
+settle_s voltage_limited unstable fault truth""".split()
+TRUTH_FIELDS = "pin_W pcu_W pfe_W pmech_W pinvm_W pm_W temp_C".split()
+failures = []
+
+
+def run(*args):
+    p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=120)
+    return p.returncode, p.stdout, p.stderr
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+code, out, _ = run("--version")
+check(code == 0 and out.startswith("synbench "), "--version")
+code, out, _ = run("point", "--help")
+check(code == 0 and "--speed-rpm" in out and "--window-s" in out, "point --help")
+code, out, _ = run("--help")
+check(code == 0 and "point" in out, "--help lists the commands")
+
+code, out, err = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52", "--json")
+check(code == 0, f"point --json exits 0 ({err.strip()})")
+rec = json.loads(out)
+check(list(rec.keys()) == RECORD_FIELDS, "record has the experiment.md fields in order")
+check(sorted(rec["truth"].keys()) == sorted(TRUTH_FIELDS), "truth object fields")
+check(abs(rec["speed_meas_rpm"] - 700) < 0.5, "measured speed at the setpoint")
+check(rec["samples"] == 10000 and rec["window_s"] == 1, "one-second window at 10 kHz")
+check(50 < rec["pdcm_W"] < 1000 and 0.3 < rec["efficiency"] < 0.95, "plausible power and efficiency")
+check(rec["estimator"] == "encoder" and rec["pwm"] == "capwm" and rec["fault"] is None, "setpoints and flags")
+check(abs(rec["temp_C"] - 50) < 1, "starts at the 50 degC bench setpoint")
+
+code, out, _ = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52", "--temp-C", "30",
+                   "--pwm", "aspwm", "--window-s", "0.5", "--json")
+rec2 = json.loads(out)
+check(code == 0 and rec2["pwm"] == "aspwm" and abs(rec2["temp_C"] - 30) < 1 and rec2["samples"] == 5000,
+      "--pwm, --temp-C and --window-s reach the record")
+
+code, out, _ = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52")
+check(code == 0 and "pdcm_W" in out and "truth" in out, "readable output")
+
+bad = [
+    (["--speed-rpm", "5000", "--load-Nm", "1", "--angle-deg", "50"], "--speed-rpm"),
+    (["--speed-rpm", "0", "--load-Nm", "1", "--angle-deg", "50"], "--speed-rpm"),
+    (["--speed-rpm", "abc", "--load-Nm", "1", "--angle-deg", "50"], "--speed-rpm"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "0"], "--angle-deg"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "90"], "--angle-deg"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--window-s", "0"], "--window-s"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--window-s", "-2"], "--window-s"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--pwm", "spwm"], "--pwm"),
+    (["--speed-rpm", "500", "--load-Nm", "-1", "--angle-deg", "50"], "--load-Nm"),
+    (["--speed-rpm", "500", "--angle-deg", "50"], "--load-Nm"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--udc-V", "5"], "--udc-V"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--estimator", "magic"], "--estimator"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--frobnicate"], "--frobnicate"),
+    (["--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--config", "/nonexistent.json"], "--config"),
+]
+for args, flag in bad:
+    code, out, err = run("point", *args)
+    check(code == 2 and flag in err and out == "", f"exit 2 naming {flag} for {' '.join(args[-2:])}: {err.strip()}")
+
+with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+    json.dump({"synrm": {"rs_ohm": -3}}, f)
+code, out, err = run("point", "--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--config", f.name)
+check(code == 2 and "synrm.rs_ohm" in err, f"bad config names the key: {err.strip()}")
+code, out, err = run("config", "--check", f.name)
+check(code == 2 and "synrm.rs_ohm" in err, "config --check names the key")
+os.unlink(f.name)
+
+with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+    json.dump({"firmware": {"max_speed_rpm": 1000}}, f)
+code, out, err = run("point", "--speed-rpm", "1200", "--load-Nm", "1", "--angle-deg", "50", "--config", f.name)
+check(code == 2 and "--speed-rpm" in err and "1000" in err, "the configured maximum speed applies")
+os.unlink(f.name)
+
+print(f"{(len(failures) == 0) and 'all' or len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
+sys.exit(1 if failures else 0)
