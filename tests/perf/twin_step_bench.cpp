@@ -31,8 +31,8 @@ void BM_TwinStep(benchmark::State& state, Pwm pwm) {
                          benchmark::Counter::kIsRate);
 }
 
-BENCHMARK_CAPTURE(BM_TwinStep, encoder_capwm, Pwm::capwm)->MinTime(2.0);
-BENCHMARK_CAPTURE(BM_TwinStep, encoder_aspwm, Pwm::aspwm)->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_TwinStep, encoder_capwm, Pwm::capwm);
+BENCHMARK_CAPTURE(BM_TwinStep, encoder_aspwm, Pwm::aspwm);
 
 }  // namespace
 
