@@ -1,0 +1,32 @@
+// Interface of a position/speed/parameter estimator running in the SynRM drive firmware
+// (physics.md 8). The firmware calls update() once per PWM period with what its sensors saw;
+// the selected estimator's angle and speed then drive the FOC (the encoder is only the reference).
+#pragma once
+
+#include <optional>
+
+namespace synbench::emulator::firmware {
+
+struct EstimatorInput {
+  double ts_s = 1e-4;
+  double ialpha_A = 0, ibeta_A = 0;  // measured phase currents, stationary frame
+  double ualpha_V = 0, ubeta_V = 0;  // voltage applied during the period that just ended
+  // One MCIDC sample of this period: phase index (0 a, 1 b, 2 c) and R'_ph in 1/H.
+  std::optional<int> mcidc_phase;
+  double mcidc_reluctance_per_H = 0;
+};
+
+struct EstimatorOutput {
+  double theta_e_rad = 0;    // estimated electrical angle
+  double omega_e_rad_s = 0;  // estimated electrical speed
+  std::optional<double> ld_H, lq_H, rs_ohm;
+};
+
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+  virtual void update(const EstimatorInput& in) = 0;
+  virtual EstimatorOutput output() const = 0;
+};
+
+}  // namespace synbench::emulator::firmware
