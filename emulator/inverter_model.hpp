@@ -53,7 +53,8 @@ class InverterModel {
 
   // Conduction and switching loss of the three legs for phase currents `i` and leg duties `d`.
   double loss_W(const Phases& i, const Phases& d, double udc_V, drivers::Pwm pwm) const {
-    const double k_sw = pwm == drivers::Pwm::capwm ? 2.0 : 4.0 / 3.0;
+    // Switching events per leg and period: 12 edges -> 2 per leg (CAPWM), 8 -> 4/3 (ASPWM).
+    const double k_sw = edges_per_period(pwm) / 6.0;
     const double e_scale = udc_V / p_.esw_ref_V;
     double loss = 0;
     for (int n = 0; n < 3; ++n) {
