@@ -131,7 +131,7 @@ void Twin::step() {
   }
   const double p_inv_g = load_inverter_loss_W(x_);
 
-  if (mcidc_enabled && gates) {
+  if (synrm_fw_.needs_mcidc() && gates) {
     mcidc_sample_ = mcidc_.measure(steps_, applied_.pwm, applied_.duty, th,
                                    synrm_.d_axis().dynamic_inductance_H(cur.id0),
                                    synrm_.q_axis().dynamic_inductance_H(cur.iq0), noise_);
@@ -147,6 +147,7 @@ void Twin::step() {
   sample.encoder_count = static_cast<std::int64_t>(std::floor(x_.angle_rad / (2.0 * kPi) * counts_per_rev_));
   sample.udc_V = udc;
   sample.temp_C = thermal_.temp_C();
+  sample.mcidc = mcidc_sample_;
   const firmware::DriveOutput next = synrm_fw_.control(sample);
   const double load_iref = load_fw_.control(x_.load_iq_A + sigma * noise_.gauss());
 

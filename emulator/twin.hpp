@@ -66,8 +66,8 @@ class Twin {
   const PlantState& state() const { return x_; }
   const SynrmModel& synrm_model() const { return synrm_; }
   // The last MCIDC sample (none when the active vector was too short or the gates are off).
+  // Sampled only when the selected estimator needs it (it costs a Gaussian per period).
   const std::optional<McidcSample>& mcidc_sample() const { return mcidc_sample_; }
-  bool mcidc_enabled = false;  // the estimators switch it on; it costs a Gaussian per period
 
  private:
   struct Rates;

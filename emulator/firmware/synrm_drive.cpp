@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "drivers/error.hpp"
+#include "emulator/firmware/estimators/factory.hpp"
 
 namespace synbench::emulator::firmware {
 namespace {
@@ -90,9 +91,15 @@ std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {
 }
 
 std::error_code SynrmDriveFirmware::set_estimator(drivers::Estimator estimator) {
-  // Sensorless estimators arrive with the estimator issue; the encoder is the only source yet.
-  return estimator == drivers::Estimator::encoder ? std::error_code{}
-                                                  : make_error_code(errc::not_supported);
+  if (estimator == estimator_kind_) return {};
+  // The position source changes only with the gates off: a running FOC would lose its angle.
+  if (state_ == drivers::DriveState::running) return make_error_code(errc::busy);
+  auto choice = make_estimator(estimator, cfg_);
+  if (choice.error) return choice.error;
+  estimator_ = std::move(choice.estimator);
+  needs_mcidc_ = choice.needs_mcidc;
+  estimator_kind_ = estimator;
+  return {};
 }
 
 std::error_code SynrmDriveFirmware::reset_fault() {
@@ -150,10 +157,27 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
 
   check_protection(s, ia, ib, speed_rpm);
 
-  const double theta_e = wrap_pi(pole_pairs_ * theta_m);
-  const double we = pole_pairs_ * obs_omega_;
-  const double ca = std::cos(theta_e), sa = std::sin(theta_e);
+  const double theta_enc = wrap_pi(pole_pairs_ * theta_m);
   const double i_alpha = ia, i_beta = (ia + 2.0 * ib) / kSqrt3;  // Clarke with ic = -ia - ib
+  double theta_e = theta_enc, we = pole_pairs_ * obs_omega_;
+  if (estimator_) {
+    EstimatorInput in;
+    in.ts_s = ts_;
+    in.ialpha_A = i_alpha;
+    in.ibeta_A = i_beta;
+    in.ualpha_V = u_hist_[1][0];
+    in.ubeta_V = u_hist_[1][1];
+    if (s.mcidc) {
+      in.mcidc_phase = s.mcidc->phase;
+      in.mcidc_reluctance_per_H = s.mcidc->reluctance_per_H;
+    }
+    estimator_->update(in);
+    const EstimatorOutput o = estimator_->output();
+    theta_e = wrap_pi(o.theta_e_rad);
+    we = o.omega_e_rad_s;
+  }
+  const double speed_ctrl_rpm = we / pole_pairs_ * kRpmPerRadS;
+  const double ca = std::cos(theta_e), sa = std::sin(theta_e);
   id_meas_ = ca * i_alpha + sa * i_beta;
   iq_meas_ = -sa * i_alpha + ca * i_beta;
 
@@ -166,7 +190,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       const double dt = ts_ * speed_divider_;
       const double max_step = cfg_.firmware.speed_ramp_rpm_per_s * dt;
       speed_ref_rpm_ += std::clamp(speed_set_rpm_ - speed_ref_rpm_, -max_step, max_step);
-      im_req_A_ = speed_pi_.update((speed_ref_rpm_ - speed_rpm) / kRpmPerRadS, dt);
+      im_req_A_ = speed_pi_.update((speed_ref_rpm_ - speed_ctrl_rpm) / kRpmPerRadS, dt);
     }
     // Motoring and braking both keep i_d positive; the sign of I_m goes to i_q (torque sign).
     const double id_ref = std::fabs(im_req_A_) * std::cos(angle_rad_);
@@ -210,6 +234,10 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     out.ubeta_V = ubeta;
     out.duty = InverterModel::duties(ualpha, ubeta, s.udc_V);
   }
+  u_hist_[1][0] = u_hist_[0][0];
+  u_hist_[1][1] = u_hist_[0][1];
+  u_hist_[0][0] = out.ualpha_V;
+  u_hist_[0][1] = out.ubeta_V;
 
   const double im = std::hypot(id_meas_, iq_meas_);
   f_speed_.update(speed_rpm);
@@ -221,7 +249,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   f_udc_.update(s.udc_V);
   f_pac_.update(1.5 * (ud_ref_ * id_meas_ + uq_ref_ * iq_meas_));
   f_temp_.update(s.temp_C);
-  accumulate(s, im, id_meas_, iq_meas_, limited_);
+  accumulate(s, im, id_meas_, iq_meas_, limited_, theta_e - theta_enc, speed_ctrl_rpm - speed_rpm);
   return out;
 }
 
@@ -230,11 +258,13 @@ void SynrmDriveFirmware::begin_window(std::int64_t steps) {
   window_count_start_ = -1;
   window_limited_ = 0;
   window_fault_ = state_ == drivers::DriveState::faulted ? fault_ : drivers::Fault::none;
-  for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_}) w->reset();
+  for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_, &w_pos_err_,
+                         &w_speed_err_, &w_ld_, &w_lq_, &w_rs_})
+    w->reset();
 }
 
 void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, double iq,
-                                    bool limited) {
+                                    bool limited, double pos_err_rad, double speed_err_rpm) {
   if (window_left_ <= 0) return;
   if (window_count_start_ < 0) window_count_start_ = s.encoder_count;
   w_im_.add(im);
@@ -245,6 +275,17 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   w_udc_.add(s.udc_V);
   w_temp_.add(s.temp_C);
   window_limited_ += limited ? 1 : 0;
+  if (estimator_) {
+    // A SynRM is symmetric under 180 electrical degrees: the error is wrapped to (-90, 90].
+    double e = std::remainder(pos_err_rad, kPi) * 180.0 / kPi;
+    if (e <= -90.0) e += 180.0;
+    w_pos_err_.add(e);
+    w_speed_err_.add(speed_err_rpm);
+    const EstimatorOutput o = estimator_->output();
+    if (o.ld_H) w_ld_.add(*o.ld_H);
+    if (o.lq_H) w_lq_.add(*o.lq_H);
+    if (o.rs_ohm) w_rs_.add(*o.rs_ohm);
+  }
   if (--window_left_ > 0) return;
   drivers::SynrmWindow r;
   r.samples = static_cast<std::uint32_t>(w_im_.count());
@@ -262,6 +303,15 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   r.temp_C = w_temp_.mean();
   r.voltage_limited_fraction = static_cast<double>(window_limited_) / static_cast<double>(r.samples);
   r.fault = state_ == drivers::DriveState::faulted ? fault_ : window_fault_;
+  if (estimator_) {
+    r.pos_err_min_deg = w_pos_err_.min();
+    r.pos_err_mean_deg = w_pos_err_.mean();
+    r.pos_err_max_deg = w_pos_err_.max();
+    r.speed_err_rpm = w_speed_err_.mean();
+    if (w_ld_.count()) r.ld_est_H = w_ld_.mean();
+    if (w_lq_.count()) r.lq_est_H = w_lq_.mean();
+    if (w_rs_.count()) r.rs_est_ohm = w_rs_.mean();
+  }
   window_result_ = r;
 }
 

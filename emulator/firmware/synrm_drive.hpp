@@ -6,13 +6,17 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <system_error>
 
 #include "drivers/devices.hpp"
+#include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/pi.hpp"
 #include "emulator/firmware/window_stats.hpp"
 #include "emulator/flux_map.hpp"
 #include "emulator/inverter_model.hpp"
+#include "emulator/mcidc.hpp"
 #include "emulator/twin_config.hpp"
 
 namespace synbench::emulator::firmware {
@@ -23,6 +27,7 @@ struct DriveSample {
   std::int64_t encoder_count = 0; // multi-turn encoder position
   double udc_V = 0;
   double temp_C = 0;
+  std::optional<McidcSample> mcidc;  // phase-reluctance sample, when the estimator asks for it
 };
 
 // What the drive commands for the next PWM period.
@@ -56,12 +61,14 @@ class SynrmDriveFirmware {
   drivers::DriveState state() const { return state_; }
   drivers::Fault fault() const { return fault_; }
   drivers::Pwm pwm() const { return pwm_; }
+  bool needs_mcidc() const { return needs_mcidc_; }
   double speed_reference_rpm() const { return speed_ref_rpm_; }
 
  private:
   void check_protection(const DriveSample& s, double ia, double ib, double speed_rpm);
   void gates_off();
-  void accumulate(const DriveSample& s, double im, double id, double iq, bool limited);
+  void accumulate(const DriveSample& s, double im, double id, double iq, bool limited,
+                  double theta_enc, double speed_enc_rpm);
 
   TwinConfig cfg_;
   double ts_;
@@ -79,6 +86,13 @@ class SynrmDriveFirmware {
   drivers::Pwm pwm_;
   double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0;
   std::uint64_t step_ = 0;
+
+  // Position source: the selected estimator, or the encoder when null.
+  drivers::Estimator estimator_kind_ = drivers::Estimator::encoder;
+  std::unique_ptr<Estimator> estimator_;
+  bool needs_mcidc_ = false;
+  // Voltages commanded one and two periods ago: the older one acted during the last period.
+  double u_hist_[2][2] = {{0, 0}, {0, 0}};
 
   // Encoder speed observer (tracking PLL on the mechanical angle).
   bool observer_init_ = false;
@@ -98,6 +112,7 @@ class SynrmDriveFirmware {
   long window_limited_ = 0;
   drivers::Fault window_fault_ = drivers::Fault::none;
   WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;
+  WindowStats w_pos_err_, w_speed_err_, w_ld_, w_lq_, w_rs_;
   drivers::SynrmWindow window_result_;
 };
 
