@@ -36,7 +36,8 @@ struct HeartbeatTiming {
   std::uint32_t timeout_ms = 0;  // how long the device waits for a change before it trips
 };
 
-// A named value of an enumerated signal (state, estimator, ...), in engineering units.
+// The device's number for one of the bench's labels of an enumerated signal (state,
+// estimator, ...): how a drive with its own codes is translated to the bench's.
 struct EnumValue {
   std::int64_t value = 0;
   std::string label;
@@ -51,7 +52,7 @@ struct ProfileSignal {
   RegisterEncoding encoding;  // type boolean for coils and discrete inputs; limits ±inf if absent
   std::string unit;           // engineering unit, as in the signal's name; empty if dimensionless
   Access access = Access::r;
-  std::vector<EnumValue> values;           // sorted by value; empty unless enumerated
+  std::vector<EnumValue> values;             // sorted by value; empty: the bench's own codes
   std::optional<HeartbeatTiming> heartbeat;  // set on the heartbeat signal only
 
   bool readable() const { return access != Access::w; }

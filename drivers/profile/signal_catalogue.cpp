@@ -3,26 +3,38 @@
 // driver answers errc::not_supported for an optional signal its profile leaves out.
 #include "drivers/profile/signal_catalogue.hpp"
 
+#include "drivers/fault.hpp"
+#include "drivers/modes.hpp"
+
 namespace synbench::drivers {
 namespace {
 
 using R = SignalRole;
 
+// Labels come from the enums in drivers/ wherever those exist, so they cannot drift apart.
+constexpr std::array<std::string_view, 4> kStateLabels{"disabled", "running", "stopping", "faulted"};
+constexpr std::array<std::string_view, 3> kWindowStatusLabels{"idle", "open", "done"};
+constexpr std::array<std::string_view, 10> kFaultLabels{
+    fault_name(Fault::none),         fault_name(Fault::overcurrent), fault_name(Fault::overvoltage),
+    fault_name(Fault::undervoltage), fault_name(Fault::overspeed),   fault_name(Fault::overtemperature),
+    fault_name(Fault::watchdog),     fault_name(Fault::estop),       fault_name(Fault::link_loss),
+    fault_name(Fault::load_drive)};
+
 constexpr SignalSpec kSynrm[] = {
     {"enable", R::command, true, "", "1 runs the drive, 0 ramps it down and disables it"},
     {"speed_setpoint_rpm", R::command, true, "rpm", "speed reference"},
     {"angle_setpoint_deg", R::command, true, "deg", "current-vector angle from the d axis"},
-    {"pwm_scheme", R::command, false, "", "0 capwm, 1 aspwm"},
+    {"pwm_scheme", R::command, false, "", "switching scheme", kPwmNames},
     {"estimator", R::command, false, "",
-     "position source: 0 encoder, 1 ekf-basic, 2 ekf-rs, 3 hfi, 4 eemf-const, 5 eemf-lut, 6 eemf-rls"},
+     "position source", kEstimatorNames},
     {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault"},
     {"heartbeat", R::heartbeat, true, "",
      "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
      "has not changed for timeout_ms"},
     {"window_start", R::window_start, true, "", "writing 1 opens a window of window_length_ms"},
     {"window_length_ms", R::window_length, true, "ms", "length of the next window"},
-    {"state", R::telemetry, true, "", "0 disabled, 1 running, 2 stopping, 3 faulted"},
-    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp), 0 none"},
+    {"state", R::telemetry, true, "", "drive state", kStateLabels},
+    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp)", kFaultLabels},
     {"speed_rpm", R::telemetry, true, "rpm", "filtered speed"},
     {"im_A", R::telemetry, false, "A", "current-vector magnitude"},
     {"id_A", R::telemetry, false, "A", "d current"},
@@ -33,11 +45,11 @@ constexpr SignalSpec kSynrm[] = {
     {"pac_W", R::telemetry, false, "W", "the drive's estimate of its output power"},
     {"temp_C", R::telemetry, false, "C", "power-stage temperature"},
     {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
-    {"window_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
     {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, true, "", "control periods accumulated"},
     {"window_s", R::window_result, true, "s", "accumulated duration"},
-    {"window_fault_code", R::window_result, false, "", "fault latched during the window, 0 none"},
+    {"window_fault_code", R::window_result, false, "", "fault latched during the window", kFaultLabels},
     {"window_speed_meas_rpm", R::window_result, false, "rpm", "speed from encoder counts over the window"},
     {"window_im_A", R::window_result, false, "A", "mean"},
     {"window_id_A", R::window_result, false, "A", "mean"},
@@ -66,11 +78,11 @@ constexpr SignalSpec kLoad[] = {
     {"window_start", R::window_start, false, "",
      "writing 1 opens a window of window_length_ms; for a bench without a trigger line"},
     {"window_length_ms", R::window_length, false, "ms", "length of the next window"},
-    {"state", R::telemetry, true, "", "0 disabled, 1 running, 2 stopping, 3 faulted"},
-    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp), 0 none"},
+    {"state", R::telemetry, true, "", "drive state", kStateLabels},
+    {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp)", kFaultLabels},
     {"torque_Nm", R::telemetry, true, "Nm", "braking torque magnitude from the measured current"},
     {"iq_A", R::telemetry, false, "A", "q current"},
-    {"window_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
     {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, true, "", "control periods accumulated"},
     {"window_torque_Nm", R::window_result, true, "Nm", "mean braking torque"},
@@ -79,7 +91,7 @@ constexpr SignalSpec kLoad[] = {
 constexpr SignalSpec kMeter[] = {
     {"gate_start", R::window_start, true, "", "writing 1 opens a gate of gate_length_ms"},
     {"gate_length_ms", R::window_length, true, "ms", "length of the next gate"},
-    {"gate_status", R::window_status, true, "", "0 idle, 1 open, 2 done"},
+    {"gate_status", R::window_status, true, "", "gate state", kWindowStatusLabels},
     {"gate_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed gate"},
     {"counts_m", R::window_result, true, "", "VFC pulses of the motor-side DC current over the gate"},
     {"counts_g", R::window_result, true, "", "VFC pulses of the generator-side DC current over the gate"},

@@ -32,7 +32,10 @@ struct SignalSpec {
   SignalRole role;
   bool required;
   std::string_view unit;  // engineering unit after scaling; empty when dimensionless
-  std::string_view doc;   // meaning, including enum values
+  std::string_view doc;   // meaning
+  // An enumerated signal's labels, indexed by the bench's code (state: labels[3] == "faulted").
+  // A profile's "values" map these labels to the device's own numbers.
+  std::span<const std::string_view> labels = {};
 };
 
 inline constexpr std::array<DeviceKind, 3> kDeviceKinds{DeviceKind::synrm_drive, DeviceKind::load_drive,
