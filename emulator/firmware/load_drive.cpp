@@ -15,6 +15,7 @@ LoadDriveFirmware::LoadDriveFirmware(const TwinConfig& config)
 }
 
 std::error_code LoadDriveFirmware::enable(bool on) {
+  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!on) {
     torque_cmd_Nm_ = 0;
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
@@ -26,6 +27,7 @@ std::error_code LoadDriveFirmware::enable(bool on) {
 }
 
 std::error_code LoadDriveFirmware::set_torque_Nm(double torque_Nm) {
+  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!std::isfinite(torque_Nm) || torque_Nm < 0 ||
       torque_Nm > kt_ * cfg_.load.current_limit_A)
     return make_error_code(errc::invalid_argument);
@@ -47,8 +49,19 @@ void LoadDriveFirmware::trip(drivers::Fault fault) {
   torque_cmd_Nm_ = 0;
 }
 
+void LoadDriveFirmware::stop_and_latch(drivers::Fault fault) {
+  if (state_ != drivers::DriveState::running) {
+    if (state_ != drivers::DriveState::stopping) trip(fault);
+    return;
+  }
+  state_ = drivers::DriveState::stopping;
+  pending_fault_ = fault;
+  torque_set_Nm_ = 0.0;
+}
+
 double LoadDriveFirmware::control(double iq_measured_A) {
-  if (state_ == drivers::DriveState::running) {
+  if (state_ == drivers::DriveState::stopping && torque_cmd_Nm_ == 0.0) trip(pending_fault_);
+  if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) {
     const double max_step = cfg_.load.torque_ramp_Nm_per_s * ts_;
     torque_cmd_Nm_ += std::clamp(torque_set_Nm_ - torque_cmd_Nm_, -max_step, max_step);
   } else {

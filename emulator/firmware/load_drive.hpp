@@ -21,6 +21,9 @@ class LoadDriveFirmware {
   std::error_code set_torque_Nm(double torque_Nm);
   std::error_code reset_fault();
   void trip(drivers::Fault fault);
+  // Ordered stop on the drive's own initiative (watchdog): ramps the torque to zero, then
+  // latches `fault`.
+  void stop_and_latch(drivers::Fault fault);
 
   // One PWM period: returns the current reference (braking magnitude, A).
   double control(double iq_measured_A);
@@ -36,6 +39,7 @@ class LoadDriveFirmware {
   double ts_, kt_;
   drivers::DriveState state_ = drivers::DriveState::disabled;
   drivers::Fault fault_ = drivers::Fault::none;
+  drivers::Fault pending_fault_ = drivers::Fault::none;
   double torque_set_Nm_ = 0, torque_cmd_Nm_ = 0;
   LowPass f_iq_;
   std::int64_t window_left_ = 0;

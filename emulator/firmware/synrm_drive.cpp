@@ -11,6 +11,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRpmPerRadS = 60.0 / (2.0 * kPi);
+// An ordered stop ends (gates off) below this speed.
+constexpr double kStoppedRpm = 20.0;
 
 double wrap_pi(double x) {
   x = std::fmod(x + kPi, 2.0 * kPi);
@@ -56,6 +58,7 @@ SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
 }
 
 std::error_code SynrmDriveFirmware::enable(bool on) {
+  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!on) {
     gates_off();
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
@@ -72,6 +75,7 @@ std::error_code SynrmDriveFirmware::enable(bool on) {
 }
 
 std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
+  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!std::isfinite(speed_rpm) || std::fabs(speed_rpm) > cfg_.firmware.max_speed_rpm)
     return make_error_code(errc::invalid_argument);
   speed_set_rpm_ = speed_rpm;
@@ -93,7 +97,8 @@ std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {
 std::error_code SynrmDriveFirmware::set_estimator(drivers::Estimator estimator) {
   if (estimator == estimator_kind_) return {};
   // The position source changes only with the gates off: a running FOC would lose its angle.
-  if (state_ == drivers::DriveState::running) return make_error_code(errc::busy);
+  if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping)
+    return make_error_code(errc::busy);
   auto choice = make_estimator(estimator, cfg_);
   if (choice.error) return choice.error;
   estimator_ = std::move(choice.estimator);
@@ -117,6 +122,16 @@ void SynrmDriveFirmware::trip(drivers::Fault fault) {
   gates_off();
 }
 
+void SynrmDriveFirmware::stop_and_latch(drivers::Fault fault) {
+  if (state_ != drivers::DriveState::running) {
+    if (state_ != drivers::DriveState::stopping) trip(fault);
+    return;
+  }
+  state_ = drivers::DriveState::stopping;
+  pending_fault_ = fault;
+  speed_set_rpm_ = 0.0;
+}
+
 void SynrmDriveFirmware::gates_off() {
   speed_pi_.reset();
   id_pi_.reset();
@@ -134,7 +149,8 @@ void SynrmDriveFirmware::check_protection(const DriveSample& s, double ia, doubl
   if (s.udc_V > f.overvoltage_trip_V) return trip(drivers::Fault::overvoltage);
   if (std::fabs(speed_rpm) > f.overspeed_trip_rpm) return trip(drivers::Fault::overspeed);
   if (s.temp_C > f.overtemp_trip_C) return trip(drivers::Fault::overtemperature);
-  if (state_ == drivers::DriveState::running && s.udc_V < f.undervoltage_trip_V)
+  if ((state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) &&
+      s.udc_V < f.undervoltage_trip_V)
     return trip(drivers::Fault::undervoltage);
 }
 
@@ -184,7 +200,10 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   DriveOutput out;
   out.pwm = pwm_;
   limited_ = false;
-  if (state_ == drivers::DriveState::running) {
+  if (state_ == drivers::DriveState::stopping && std::fabs(speed_rpm) < kStoppedRpm &&
+      std::fabs(speed_ref_rpm_) < kStoppedRpm)
+    trip(pending_fault_);
+  if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) {
     // Speed loop at its own rate, on a ramped reference.
     if (step_ % static_cast<std::uint64_t>(speed_divider_) == 0) {
       const double dt = ts_ * speed_divider_;

@@ -48,8 +48,11 @@ class SynrmDriveFirmware {
   std::error_code set_pwm(drivers::Pwm pwm);
   std::error_code set_estimator(drivers::Estimator estimator);
   std::error_code reset_fault();
-  // Latches a fault raised outside the control loop (watchdog, E-stop): gates off at once.
+  // Latches a fault raised outside the control loop (E-stop): gates off at once.
   void trip(drivers::Fault fault);
+  // Ordered stop on the drive's own initiative (watchdog): ramps the speed to zero under control,
+  // then gates off and latches `fault`. State `stopping` until then; commands are refused.
+  void stop_and_latch(drivers::Fault fault);
 
   DriveOutput control(const DriveSample& sample);
 
@@ -83,6 +86,7 @@ class SynrmDriveFirmware {
 
   drivers::DriveState state_ = drivers::DriveState::disabled;
   drivers::Fault fault_ = drivers::Fault::none;
+  drivers::Fault pending_fault_ = drivers::Fault::none;  // latched when the ordered stop ends
   drivers::Pwm pwm_;
   double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0;
   std::uint64_t step_ = 0;

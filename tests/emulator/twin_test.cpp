@@ -81,3 +81,43 @@ TEST(Twin, WarmerWindingLosesMoreInCopper) {
 
 }  // namespace
 }  // namespace synbench
+
+namespace synbench {
+namespace {
+
+TEST(Twin, OwnOrderedStopRampsDownThenLatches) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  auto& t = bench.twin();
+  auto d = bench.devices();
+  ASSERT_FALSE(d.synrm->set_angle_deg(56));
+  ASSERT_FALSE(d.synrm->set_speed_rpm(900));
+  ASSERT_FALSE(d.synrm->enable(true));
+  ASSERT_FALSE(d.load->enable(true));
+  bench.clock().wait_until(1.5);
+  ASSERT_FALSE(d.load->set_torque_Nm(2.0));
+  bench.clock().wait_until(3.0);
+  // What a watchdog does: both drives stop on their own.
+  t.load_drive().stop_and_latch(drivers::Fault::watchdog);
+  t.synrm_drive().stop_and_latch(drivers::Fault::watchdog);
+  EXPECT_EQ(t.synrm_drive().state(), drivers::DriveState::stopping);
+  EXPECT_EQ(d.synrm->set_speed_rpm(900), make_error_code(errc::device_fault)) << "no commands while stopping";
+  bench.clock().wait_until(3.2);
+  EXPECT_GT(t.snapshot().speed_rpm, 500) << "a ramp, not a coast";
+  EXPECT_EQ(t.synrm_drive().state(), drivers::DriveState::stopping);
+  bench.clock().wait_until(5.0);
+  EXPECT_EQ(t.synrm_drive().state(), drivers::DriveState::faulted);
+  EXPECT_EQ(t.synrm_drive().fault(), drivers::Fault::watchdog);
+  EXPECT_LT(std::fabs(t.snapshot().speed_rpm), 25.0);
+  drivers::LoadTelemetry lt;
+  ASSERT_FALSE(d.load->read(lt));
+  EXPECT_EQ(lt.state, drivers::DriveState::faulted);
+  EXPECT_EQ(lt.fault, drivers::Fault::watchdog);
+  EXPECT_NEAR(t.snapshot().load_torque_Nm, 0.0, 1e-9);
+  EXPECT_EQ(d.synrm->enable(true), make_error_code(errc::device_fault));
+  ASSERT_FALSE(d.synrm->reset_fault());
+  ASSERT_FALSE(d.load->reset_fault());
+  EXPECT_FALSE(d.synrm->enable(true));
+}
+
+}  // namespace
+}  // namespace synbench
