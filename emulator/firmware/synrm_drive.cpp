@@ -221,8 +221,14 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     id_pi_.set_limits(-u_max, u_max);
     iq_pi_.set_limits(-u_max, u_max);
     const bool hold = limited_hold_s_ > 0;
-    const double ud = id_pi_.update(id_ref - id_meas_, ts_, hold) - we * flux_q_.psi(iq_ref);
-    const double uq = iq_pi_.update(iq_ref - iq_meas_, ts_, hold) + we * flux_d_.psi(id_ref);
+    // The loops regulate the fundamental: an injecting estimator removes its own response.
+    double id_fb = id_meas_, iq_fb = iq_meas_, ud_inj = 0, uq_inj = 0;
+    if (estimator_) {
+      estimator_->fundamental(id_fb, iq_fb);
+      estimator_->injection(ud_inj, uq_inj);
+    }
+    const double ud = id_pi_.update(id_ref - id_fb, ts_, hold) - we * flux_q_.psi(iq_ref) + ud_inj;
+    const double uq = iq_pi_.update(iq_ref - iq_fb, ts_, hold) + we * flux_d_.psi(id_ref) + uq_inj;
     ud_ref_ = ud;
     uq_ref_ = uq;
     // Inverse Park at the angle the voltage will act at (one period of delay plus half a period).

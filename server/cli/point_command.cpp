@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "bench/point_procedure.hpp"
+#include "emulator/firmware/estimators/factory.hpp"
 #include "emulator/twin_bench.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
@@ -24,7 +25,7 @@ required:
 
 options:
   --pwm S            capwm (default) or aspwm
-  --estimator E      position source: encoder (default)
+  --estimator E      position source: encoder (default), ekf-basic, ekf-rs, hfi
   --udc-V V          DC-bus source voltage; chopper and trips scale with it (default 425)
   --window-s S       measurement window (VFC gate), s (default 1)
   --temp-C T         winding temperature at start (default 50, the bench setpoint)
@@ -100,9 +101,9 @@ int point_command(const std::vector<std::string>& argv) {
       throw UsageError("--angle-deg", fmt(req.angle_deg) + " is outside (0, 90) deg");
     if (req.window_s <= 0 || req.window_s > 3600)
       throw UsageError("--window-s", fmt(req.window_s) + " is outside (0, 3600] s");
-    if (req.estimator != drivers::Estimator::encoder)
+    if (auto avail = emulator::firmware::make_estimator(req.estimator, config); avail.error)
       throw UsageError("--estimator", "'" + std::string(drivers::name(req.estimator)) +
-                                          "' is not available yet; only encoder");
+                                          "' is not available in the twin yet");
     if (auto udc = a.number("--udc-V")) {
       if (*udc < 100 || *udc > 800)
         throw UsageError("--udc-V", fmt(*udc) + " is outside [100, 800] V");

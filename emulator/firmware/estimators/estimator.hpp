@@ -27,6 +27,15 @@ class Estimator {
   virtual ~Estimator() = default;
   virtual void update(const EstimatorInput& in) = 0;
   virtual EstimatorOutput output() const = 0;
+  // Voltage the estimator adds to the current controllers' output this period, in the estimated
+  // d, q frame (HFI carrier, PRBS excitation). None by default.
+  virtual void injection(double& ud_V, double& uq_V) const {
+    ud_V = 0;
+    uq_V = 0;
+  }
+  // The currents, in the estimated frame, the current controllers should regulate: an injecting
+  // estimator removes its own high-frequency response. Unchanged by default.
+  virtual void fundamental(double& /*id_A*/, double& /*iq_A*/) const {}
 };
 
 }  // namespace synbench::emulator::firmware
