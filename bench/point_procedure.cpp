@@ -164,6 +164,12 @@ void PointProcedure::read_results() {
   r.ld_est_H = w.ld_est_H;
   r.lq_est_H = w.lq_est_H;
   r.rs_est_ohm = w.rs_est_ohm;
+  auto err_pct = [](const std::optional<double>& est, const std::optional<double>& ref) {
+    return est && ref && *ref != 0 ? std::optional<double>(100.0 * (*est - *ref) / *ref) : std::nullopt;
+  };
+  r.ld_err_pct = err_pct(w.ld_est_H, w.ld_ref_H);
+  r.lq_err_pct = err_pct(w.lq_est_H, w.lq_ref_H);
+  r.rs_err_pct = err_pct(w.rs_est_ohm, w.rs_ref_ohm);
   r.temp_C = w.temp_C;
   r.window_s = m.gate_s > 0 ? m.gate_s : w.window_s;
   r.samples = w.samples;

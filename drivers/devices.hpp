@@ -41,6 +41,9 @@ struct SynrmWindow {
   // Estimator outputs; empty when the position source is the encoder.
   std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
   std::optional<double> ld_est_H, lq_est_H, rs_est_ohm;
+  // References at the operating point the estimates are judged against (dynamic inductances
+  // from the drive's flux maps, Rs at the winding temperature); empty for the encoder.
+  std::optional<double> ld_ref_H, lq_ref_H, rs_ref_ohm;
   Fault fault = Fault::none;  // fault latched during the window, if any
 };
 

@@ -115,6 +115,40 @@ struct FirmwareParams {
   std::string pwm = "capwm";
 };
 
+// Sensorless estimators (physics.md 8). The EKFs keep the thesis tuning of their own params.
+struct HfiConfig {
+  double voltage_V = 20.0;
+  double frequency_Hz = 500.0;
+  double bandpass_bandwidth_Hz = 25.0;
+  double pll_bandwidth_Hz = 10.0;
+};
+
+struct EemfConfig {
+  double ld_H = 0.65;
+  double lq_H = 0.2;
+  double observer_bandwidth_Hz = 5.0;
+  double min_speed_rpm = 500.0;
+  double handover_hysteresis_rpm = 25.0;
+  std::string low_speed_source = "encoder";
+  double lut_ld_scale = 1.0;
+  double lut_lq_scale = 1.0;
+  double rls_forgetting = 0.99;
+  double rls_p0 = 1e5;
+  double rls_sample_s = 1e-3;
+  double prbs_voltage_V = 20.0;
+  double prbs_bit_s = 0.01;
+};
+
+struct EkfConfig {
+  double rs_speed_threshold_rpm = 100.0;
+};
+
+struct EstimatorsParams {
+  HfiConfig hfi;
+  EemfConfig eemf;
+  EkfConfig ekf;
+};
+
 struct SimParams {
   int seed_int = 1;  // noise generator seed
 };
@@ -129,6 +163,7 @@ struct TwinConfig {
   VfcParams vfc;
   McidcParams mcidc;
   FirmwareParams firmware;
+  EstimatorsParams estimators;
   SimParams sim;
 
   double total_inertia_kgm2() const { return synrm.inertia_kgm2 + load.inertia_kgm2; }

@@ -153,6 +153,30 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("firmware.overtemp_trip_C", &f.overtemp_trip_C, "assumed", "winding over-temperature trip", A);
   b.choice("firmware.pwm", &f.pwm, {"capwm", "aspwm"}, "Sec. 5.2", "switching scheme at start");
 
+  auto& h = c.estimators.hfi;
+  b.pos("estimators.hfi.voltage_V", &h.voltage_V, "Sec. 6.2.2", "HFI carrier amplitude on the estimated d axis");
+  b.pos("estimators.hfi.frequency_Hz", &h.frequency_Hz, "Sec. 6.2.2", "HFI carrier frequency");
+  b.pos("estimators.hfi.bandpass_bandwidth_Hz", &h.bandpass_bandwidth_Hz, "Sec. 6.2.2", "HFI band-pass bandwidth");
+  b.pos("estimators.hfi.pll_bandwidth_Hz", &h.pll_bandwidth_Hz, "assumed", "HFI phase-locked loop bandwidth", A);
+  auto& e = c.estimators.eemf;
+  b.pos("estimators.eemf.ld_H", &e.ld_H, "Sec. 6.2.3", "EEMF-CONST d inductance");
+  b.pos("estimators.eemf.lq_H", &e.lq_H, "Sec. 6.2.3", "EEMF-CONST q inductance");
+  b.pos("estimators.eemf.observer_bandwidth_Hz", &e.observer_bandwidth_Hz, "Sec. 6.2.3", "EEMF tracking observer bandwidth");
+  b.num("estimators.eemf.min_speed_rpm", &e.min_speed_rpm, 0, 10000, "Sec. 6.3.2", "below it EEMF hands over to the low-speed source");
+  b.num("estimators.eemf.handover_hysteresis_rpm", &e.handover_hysteresis_rpm, 0, 1000, "assumed",
+        "hysteresis around the minimum speed", A);
+  b.choice("estimators.eemf.low_speed_source", &e.low_speed_source, {"hfi", "encoder"}, "Sec. 6.3.2",
+           "position source below the minimum speed");
+  b.pos("estimators.eemf.lut_ld_scale", &e.lut_ld_scale, "Sec. 4 (4.1)", "EEMF-LUT table deformation kd (1 = exact tables)");
+  b.pos("estimators.eemf.lut_lq_scale", &e.lut_lq_scale, "Sec. 4 (4.2)", "EEMF-LUT table deformation kq (1 = exact tables)");
+  b.num("estimators.eemf.rls_forgetting", &e.rls_forgetting, 0.5, 1.0, "Sec. 6.2.3", "RLS forgetting factor");
+  b.pos("estimators.eemf.rls_p0", &e.rls_p0, "Sec. 6.2.3", "RLS initial covariance diagonal");
+  b.num("estimators.eemf.rls_sample_s", &e.rls_sample_s, 1e-5, 0.1, "assumed", "RLS sample period", A);
+  b.num("estimators.eemf.prbs_voltage_V", &e.prbs_voltage_V, 0, 100, "Sec. 6.2.3", "PRBS amplitude on both axes");
+  b.pos("estimators.eemf.prbs_bit_s", &e.prbs_bit_s, "Sec. 6.2.3", "PRBS bit period");
+  b.num("estimators.ekf.rs_speed_threshold_rpm", &c.estimators.ekf.rs_speed_threshold_rpm, 0, 10000, "assumed",
+        "EKF-RS holds Rs (no process noise) below this speed (Fig. 5.21)", A);
+
   rows.push_back({"sim.seed", &c.sim.seed_int, 0, 2147483647.0, false, {}, false, "-", "noise generator seed"});
   return rows;
 }
@@ -267,6 +291,10 @@ void validate(const TwinConfig& c) {
   const double ratio = c.inverter.pwm_frequency_Hz / c.firmware.speed_loop_rate_Hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9)
     throw ConfigError("firmware.speed_loop_rate_Hz", "must divide inverter.pwm_frequency_Hz");
+  if (c.estimators.hfi.frequency_Hz * 4 > c.inverter.pwm_frequency_Hz)
+    throw ConfigError("estimators.hfi.frequency_Hz", "must be at most a quarter of the PWM frequency");
+  if (c.estimators.eemf.rls_sample_s < c.step_s())
+    throw ConfigError("estimators.eemf.rls_sample_s", "must be at least one PWM period");
   if (c.firmware.current_bandwidth_Hz * 10 > c.inverter.pwm_frequency_Hz)
     throw ConfigError("firmware.current_bandwidth_Hz", "must be at most a tenth of the PWM frequency");
   auto check_axis = [](const FluxAxisParams& p, const std::string& axis) {

@@ -183,6 +183,8 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     in.ibeta_A = i_beta;
     in.ualpha_V = u_hist_[1][0];
     in.ubeta_V = u_hist_[1][1];
+    in.encoder_theta_e_rad = theta_enc;
+    in.encoder_omega_e_rad_s = pole_pairs_ * obs_omega_;
     if (s.mcidc) {
       in.mcidc_phase = s.mcidc->phase;
       in.mcidc_reluctance_per_H = s.mcidc->reluctance_per_H;
@@ -284,7 +286,7 @@ void SynrmDriveFirmware::begin_window(std::int64_t steps) {
   window_limited_ = 0;
   window_fault_ = state_ == drivers::DriveState::faulted ? fault_ : drivers::Fault::none;
   for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_, &w_pos_err_,
-                         &w_speed_err_, &w_ld_, &w_lq_, &w_rs_})
+                         &w_speed_err_, &w_ld_, &w_lq_, &w_rs_, &w_id_enc_, &w_iq_enc_})
     w->reset();
 }
 
@@ -302,6 +304,10 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   window_limited_ += limited ? 1 : 0;
   if (estimator_) {
     // A SynRM is symmetric under 180 electrical degrees: the error is wrapped to (-90, 90].
+    // References at the true operating point: the currents in the encoder's frame.
+    const double c = std::cos(pos_err_rad), sn = std::sin(pos_err_rad);
+    w_id_enc_.add(c * id - sn * iq);
+    w_iq_enc_.add(sn * id + c * iq);
     double e = std::remainder(pos_err_rad, kPi) * 180.0 / kPi;
     if (e <= -90.0) e += 180.0;
     w_pos_err_.add(e);
@@ -336,6 +342,12 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     if (w_ld_.count()) r.ld_est_H = w_ld_.mean();
     if (w_lq_.count()) r.lq_est_H = w_lq_.mean();
     if (w_rs_.count()) r.rs_est_ohm = w_rs_.mean();
+    // The estimators see incremental inductances (MCIDC slopes, RLS): the references are the
+    // dynamic inductances of the drive's flux maps at the operating point, and Rs(T).
+    const double id_true = std::fabs(w_id_enc_.mean()), iq_true = std::fabs(w_iq_enc_.mean());
+    r.ld_ref_H = flux_d_.dynamic_inductance_H(id_true);
+    r.lq_ref_H = flux_q_.dynamic_inductance_H(iq_true);
+    r.rs_ref_ohm = rs_nominal_ohm_ * (1.0 + cfg_.synrm.rs_temp_coeff_per_K * (r.temp_C - cfg_.synrm.rs_ref_temp_C));
   }
   window_result_ = r;
 }

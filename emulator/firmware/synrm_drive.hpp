@@ -116,7 +116,7 @@ class SynrmDriveFirmware {
   long window_limited_ = 0;
   drivers::Fault window_fault_ = drivers::Fault::none;
   WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;
-  WindowStats w_pos_err_, w_speed_err_, w_ld_, w_lq_, w_rs_;
+  WindowStats w_pos_err_, w_speed_err_, w_ld_, w_lq_, w_rs_, w_id_enc_, w_iq_enc_;
   drivers::SynrmWindow window_result_;
 };
 

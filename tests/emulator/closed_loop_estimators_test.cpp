@@ -43,3 +43,70 @@ TEST(ClosedLoopEstimators, HfiHoldsTheLowSpeedRangeAndCostsCurrentAndPower) {
 
 }  // namespace
 }  // namespace synbench
+
+namespace synbench {
+namespace {
+
+// Issue "Sensorless estimators": over the grid (a subsample here; tests/perf runs the full one),
+// EKF-BASIC and EKF-RS hold |mean position error| <= 7.5 deg and Ld, Lq within 30 %, from 100 rpm.
+TEST(ClosedLoopEstimators, EkfsHoldPositionAndInductancesOverTheGrid) {
+  for (auto e : {drivers::Estimator::ekf_basic, drivers::Estimator::ekf_rs})
+    for (double speed : {100.0, 500.0, 900.0})
+      for (double load : {0.5, 2.0, 3.5})
+        for (double angle : {40.0, 58.0, 76.0}) {
+          const auto r = measure_with(e, speed, load, angle, drivers::Pwm::aspwm);
+          const std::string at = std::string(drivers::name(e)) + " " + std::to_string(speed) + " rpm " +
+                                 std::to_string(load) + " N m " + std::to_string(angle) + " deg";
+          ASSERT_FALSE(r.fault) << at;
+          ASSERT_TRUE(r.pos_err_mean_deg && r.ld_err_pct && r.lq_err_pct) << at;
+          EXPECT_LE(std::fabs(*r.pos_err_mean_deg), 7.5) << at;
+          EXPECT_LE(std::fabs(*r.ld_err_pct), 30.0) << at;
+          EXPECT_LE(std::fabs(*r.lq_err_pct), 30.0) << at;
+          EXPECT_NEAR(r.speed_meas_rpm, speed, 0.01 * speed) << at;
+          EXPECT_EQ(r.rs_est_ohm.has_value(), e == drivers::Estimator::ekf_rs) << at;
+        }
+}
+
+double mean_abs_pos_err_700(drivers::Estimator e, const emulator::TwinConfig& cfg) {
+  double sum = 0;
+  int n = 0;
+  for (double load : {0.5, 1.5, 2.5, 3.5}) {
+    emulator::TwinBench bench(cfg);
+    bench::PointRequest req;
+    req.speed_rpm = 700;
+    req.load_Nm = load;
+    req.angle_deg = 56;
+    req.estimator = e;
+    // The thesis configurations: the EKFs with ASPWM, the EEMF family with CAPWM (physics.md 8).
+    req.pwm = (e == drivers::Estimator::ekf_basic || e == drivers::Estimator::ekf_rs)
+                  ? drivers::Pwm::aspwm
+                  : drivers::Pwm::capwm;
+    bench::PointOptions opt;
+    opt.ordered_stop_after = false;
+    opt.settle_timeout_s = 5.0;
+    const auto r = bench::run_point(bench.devices(), bench.clock(), req, opt).record();
+    EXPECT_FALSE(r.fault) << drivers::name(e) << " " << load;
+    if (!r.pos_err_mean_deg) return 1e9;
+    sum += std::fabs(*r.pos_err_mean_deg);
+    ++n;
+  }
+  return sum / n;
+}
+
+// At 700 rpm: EEMF-CONST has the largest mean |position error| over the loads; EEMF-LUT with
+// exact tables is better, and worse again with a deformed table (thesis 4.1, 4.2).
+TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
+  emulator::TwinConfig cfg;
+  const double konst = mean_abs_pos_err_700(drivers::Estimator::eemf_const, cfg);
+  const double lut = mean_abs_pos_err_700(drivers::Estimator::eemf_lut, cfg);
+  const double ekf = mean_abs_pos_err_700(drivers::Estimator::ekf_basic, cfg);
+  cfg.estimators.eemf.lut_lq_scale = 1.25;
+  const double lut_off = mean_abs_pos_err_700(drivers::Estimator::eemf_lut, cfg);
+  EXPECT_GT(konst, lut + 2.0);
+  EXPECT_GT(konst, ekf);
+  EXPECT_GT(lut_off, lut + 1.0);
+  EXPECT_LT(lut, 4.0);
+}
+
+}  // namespace
+}  // namespace synbench

@@ -14,6 +14,9 @@ struct EstimatorInput {
   // One MCIDC sample of this period: phase index (0 a, 1 b, 2 c) and R'_ph in 1/H.
   std::optional<int> mcidc_phase;
   double mcidc_reluctance_per_H = 0;
+  // The encoder's angle and speed: only for a handover to the encoder below an estimator's
+  // minimum speed (the thesis ran EEMF on the encoder there); estimators must not use them.
+  double encoder_theta_e_rad = 0, encoder_omega_e_rad_s = 0;
 };
 
 struct EstimatorOutput {
@@ -36,6 +39,8 @@ class Estimator {
   // The currents, in the estimated frame, the current controllers should regulate: an injecting
   // estimator removes its own high-frequency response. Unchanged by default.
   virtual void fundamental(double& /*id_A*/, double& /*iq_A*/) const {}
+  // Takes over the given angle and speed (a handover from another position source).
+  virtual void align(double /*theta_e_rad*/, double /*omega_e_rad_s*/) {}
 };
 
 }  // namespace synbench::emulator::firmware

@@ -2,15 +2,60 @@
 #include "emulator/firmware/estimators/factory.hpp"
 
 #include "drivers/error.hpp"
+#include "emulator/firmware/estimators/eemf.hpp"
 #include "emulator/firmware/estimators/ekf_basic.hpp"
 #include "emulator/firmware/estimators/ekf_rs.hpp"
+#include "emulator/firmware/estimators/handover.hpp"
 #include "emulator/firmware/estimators/hfi.hpp"
 
 namespace synbench::emulator::firmware {
+namespace {
+
+constexpr double kRadSPerRpm = 2.0 * 3.14159265358979323846 / 60.0;
+
+std::unique_ptr<Estimator> make_hfi(const TwinConfig& config) {
+  const auto& h = config.estimators.hfi;
+  HfiParams p;
+  p.ts_s = config.step_s();
+  p.voltage_V = h.voltage_V;
+  p.frequency_Hz = h.frequency_Hz;
+  p.bandpass_bandwidth_Hz = h.bandpass_bandwidth_Hz;
+  p.pll_bandwidth_Hz = h.pll_bandwidth_Hz;
+  return std::make_unique<Hfi>(p);
+}
+
+std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) {
+  const auto& e = config.estimators.eemf;
+  EemfParams p;
+  p.ts_s = config.step_s();
+  p.model = model;
+  p.rs_ohm = config.synrm.rs_ohm;
+  p.ld_H = e.ld_H;
+  p.lq_H = e.lq_H;
+  p.flux_d = config.synrm.flux_d;
+  p.flux_q = config.synrm.flux_q;
+  p.lut_ld_scale = e.lut_ld_scale;
+  p.lut_lq_scale = e.lut_lq_scale;
+  p.observer_bandwidth_Hz = e.observer_bandwidth_Hz;
+  p.rls_forgetting = e.rls_forgetting;
+  p.rls_p0 = e.rls_p0;
+  p.rls_sample_s = e.rls_sample_s;
+  p.prbs_voltage_V = e.prbs_voltage_V;
+  p.prbs_bit_s = e.prbs_bit_s;
+  const double w_min = e.min_speed_rpm * kRadSPerRpm * config.synrm.pole_pairs;
+  const double w_hyst = e.handover_hysteresis_rpm * kRadSPerRpm * config.synrm.pole_pairs;
+  return std::make_unique<LowSpeedHandover>(
+      std::make_unique<Eemf>(p), e.low_speed_source == "hfi" ? make_hfi(config) : nullptr, w_min,
+      w_hyst);
+}
+
+}  // namespace
 
 EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config) {
   EstimatorChoice c;
   const double ts = config.step_s();
+  const double rs_threshold =
+      config.estimators.ekf.rs_speed_threshold_rpm * kRadSPerRpm * config.synrm.pole_pairs;
   switch (kind) {
     case drivers::Estimator::encoder:
       return c;
@@ -24,20 +69,26 @@ EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config
     case drivers::Estimator::ekf_rs: {
       EkfRsParams p;
       p.ts_s = ts;
+      p.rs_speed_threshold_rad_s = rs_threshold;
       c.estimator = std::make_unique<EkfRs>(p);
       c.needs_mcidc = true;
       return c;
     }
-    case drivers::Estimator::hfi: {
-      HfiParams p;
-      p.ts_s = ts;
-      c.estimator = std::make_unique<Hfi>(p);
+    case drivers::Estimator::hfi:
+      c.estimator = make_hfi(config);
       return c;
-    }
-    default:
-      c.error = make_error_code(errc::not_supported);
+    case drivers::Estimator::eemf_const:
+      c.estimator = make_eemf(config, EemfModel::constant);
+      return c;
+    case drivers::Estimator::eemf_lut:
+      c.estimator = make_eemf(config, EemfModel::lut);
+      return c;
+    case drivers::Estimator::eemf_rls:
+      c.estimator = make_eemf(config, EemfModel::rls);
       return c;
   }
+  c.error = make_error_code(errc::not_supported);
+  return c;
 }
 
 }  // namespace synbench::emulator::firmware

@@ -21,6 +21,7 @@ Hfi::Hfi(const HfiParams& p) : p_(p) {
 }
 
 void Hfi::update(const EstimatorInput& in) {
+  pll_.predict(in.ts_s);  // the angle at this sample
   const double th = pll_.theta();
   const double c = std::cos(th), s = std::sin(th);
   const double id = c * in.ialpha_A + s * in.ibeta_A;
@@ -31,14 +32,14 @@ void Hfi::update(const EstimatorInput& in) {
   const double ref = std::sin(w_hf_ * static_cast<double>(step_) * p_.ts_s - delay_rad_);
   const double eps = demod_.update(2.0 * hf_q * ref);
   // eps = -(U/2w)(1/Lq - 1/Ld) sin(2 th_err): negative when the estimate lags.
-  pll_.update(-eps / gain_A_per_rad_, in.ts_s);
+  pll_.correct(-eps / gain_A_per_rad_, in.ts_s);
   ++step_;
 }
 
 EstimatorOutput Hfi::output() const {
   EstimatorOutput o;
   o.theta_e_rad = pll_.theta();
-  o.omega_e_rad_s = pll_.omega();
+  o.omega_e_rad_s = pll_.omega();  // the noisy carrier: the smoother integral part
   return o;
 }
 

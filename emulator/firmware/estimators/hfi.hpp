@@ -31,6 +31,7 @@ class Hfi final : public Estimator {
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
   void fundamental(double& id_A, double& iq_A) const override;
+  void align(double theta_e_rad, double omega_e_rad_s) override { pll_.reset(theta_e_rad, omega_e_rad_s); }
 
  private:
   HfiParams p_;

@@ -15,18 +15,24 @@ class TrackingObserver {
   }
   void reset(double theta_rad, double omega_rad_s) {
     theta_ = theta_rad;
-    omega_ = omega_rad_s;
+    omega_ = speed_ = omega_rad_s;
   }
-  // Advances by dt with the measured angle error (true minus estimate).
-  void update(double error_rad, double dt_s) {
+  // Advances the angle to the next sample instant with the speed estimate.
+  void predict(double dt_s) { theta_ += omega_ * dt_s; }
+  // Corrects with the angle error (true minus estimate) measured at this instant.
+  void correct(double error_rad, double dt_s) {
     omega_ += ki_ * error_rad * dt_s;
-    theta_ += (omega_ + kp_ * error_rad) * dt_s;
+    theta_ += kp_ * error_rad * dt_s;
+    speed_ = omega_ + kp_ * error_rad;
   }
   double theta() const { return theta_; }
   double omega() const { return omega_; }
+  // The PI's output, integral plus proportional part: the speed the angle moves at (thesis
+  // 2.13). The integral alone lags by a second-order low-pass, too slow for a speed loop.
+  double speed() const { return speed_; }
 
  private:
-  double kp_ = 0, ki_ = 0, theta_ = 0, omega_ = 0;
+  double kp_ = 0, ki_ = 0, theta_ = 0, omega_ = 0, speed_ = 0;
 };
 
 // Second-order band-pass (RBJ biquad, 0 dB at the centre).

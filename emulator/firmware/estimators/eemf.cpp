@@ -1,0 +1,124 @@
+// EEMF observer with constant, table or RLS parameters.
+#include "emulator/firmware/estimators/eemf.hpp"
+
+#include <cmath>
+
+namespace synbench::emulator::firmware {
+
+Eemf::Eemf(const EemfParams& p) : p_(p), fd_(p.flux_d), fq_(p.flux_q) {
+  obs_.configure(p_.observer_bandwidth_Hz);
+  eg_f_.configure(p_.emf_filter_s, p_.ts_s);
+  ig_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
+  id_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
+  ed_f_.configure(p_.emf_filter_s, p_.ts_s);
+  if (p_.model == EemfModel::rls) {
+    rls_every_ = std::max(1, static_cast<int>(std::lround(p_.rls_sample_s / p_.ts_s)));
+    rls_.emplace(p_.rls_forgetting, p_.rls_p0, rls_every_ * p_.ts_s);
+  }
+}
+
+void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) const {
+  switch (p_.model) {
+    case EemfModel::constant:
+      ld_dyn = p_.ld_H;
+      lq_static = p_.lq_H;
+      return;
+    case EemfModel::lut: {
+      // Deformed tables L^ = k f(i / k) (thesis 4.1, 4.2); without cross-saturation each axis
+      // depends on its own current only.
+      const double kd = p_.lut_ld_scale, kq = p_.lut_lq_scale;
+      ld_dyn = kd * fd_.dynamic_inductance_H(ig / kd);
+      lq_static = kq * fq_.static_inductance_H(id / kq);
+      return;
+    }
+    case EemfModel::rls:
+      ld_dyn = estimate_ ? estimate_->ld_H : p_.ld_H;
+      lq_static = estimate_ ? estimate_->lq_H : p_.lq_H;
+      return;
+  }
+}
+
+void Eemf::update(const EstimatorInput& in) {
+  const double ts = in.ts_s;
+  obs_.predict(ts);  // the angle at this sample
+  const double th = obs_.theta(), w = obs_.omega();
+  const double c = std::cos(th), s = std::sin(th);
+  const double ig = c * in.ialpha_A + s * in.ibeta_A;
+  const double id = -s * in.ialpha_A + c * in.ibeta_A;
+  // The last period's voltage acted about half a period ago.
+  const double thu = th - 0.5 * w * ts;
+  const double cu = std::cos(thu), su = std::sin(thu);
+  const double ug = cu * in.ualpha_V + su * in.ubeta_V;
+  const double ud = -su * in.ualpha_V + cu * in.ubeta_V;
+
+  if (rls_) {
+    // The voltage of the period that just ended belongs to this interval; the current sample
+    // closes it. The mean current is taken from the samples strictly inside.
+    rls_ug_sum_ += ug;
+    rls_ud_sum_ += ud;
+    if (++rls_count_ < rls_every_) {
+      rls_ig_sum_ += ig;
+      rls_id_sum_ += id;
+    } else {
+      const double n = rls_every_;
+      const double inner = std::max(1, rls_every_ - 1);
+      if (rls_have_prev_ && rls_every_ > 1)
+        rls_->update(ig - rls_ig0_, id - rls_id0_, rls_ig_sum_ / inner, rls_id_sum_ / inner,
+                     rls_ug_sum_ / n, rls_ud_sum_ / n);
+      // Plausible estimates only, smoothed: the observer must not follow every wobble of a
+      // 100 ms identification memory.
+      if (auto e = rls_->estimate(); e && e->rs_ohm > 0 && e->rs_ohm < 5 * p_.rs_ohm &&
+                                     e->ld_H > 0.01 && e->lq_H > 0.01 && e->ld_H < 2 && e->lq_H < 2) {
+        if (!estimate_) {
+          estimate_ = e;
+        } else {
+          const double a = p_.rls_sample_s / (p_.rls_estimate_filter_s + p_.rls_sample_s);
+          estimate_->rs_ohm += a * (e->rs_ohm - estimate_->rs_ohm);
+          estimate_->ld_H += a * (e->ld_H - estimate_->ld_H);
+          estimate_->lq_H += a * (e->lq_H - estimate_->lq_H);
+        }
+      }
+      rls_ig0_ = ig;
+      rls_id0_ = id;
+      rls_have_prev_ = true;
+      rls_count_ = 0;
+      rls_ug_sum_ = rls_ud_sum_ = rls_ig_sum_ = rls_id_sum_ = 0;
+    }
+    inj_g_ = p_.prbs_voltage_V * prbs_g_.advance(ts, p_.prbs_bit_s);
+    inj_d_ = p_.prbs_voltage_V * prbs_d_.advance(ts, p_.prbs_bit_s);
+  }
+
+  double ld_dyn, lq;
+  // Table look-ups on smoothed currents: noise must not modulate the inductances.
+  inductances(ig_f_.update(ig), id_f_.update(id), ld_dyn, lq);
+  const double rs = (p_.model == EemfModel::rls && estimate_) ? estimate_->rs_ohm : p_.rs_ohm;
+  const double dig = have_prev_ ? (ig - ig_prev_) / ts : 0.0;
+  const double did = have_prev_ ? (id - id_prev_) / ts : 0.0;
+  ig_prev_ = ig;
+  id_prev_ = id;
+  have_prev_ = true;
+  const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w * lq * id);
+  const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w * lq * ig);
+  // The EEMF turns with the speed's sign.
+  const double err = w >= 0 ? std::atan2(-eg, ed) : std::atan2(eg, -ed);
+  obs_.correct(err, ts);
+}
+
+EstimatorOutput Eemf::output() const {
+  EstimatorOutput o;
+  o.theta_e_rad = obs_.theta();
+  o.omega_e_rad_s = obs_.speed();
+  if (estimate_) {
+    o.rs_ohm = estimate_->rs_ohm;
+    o.ld_H = estimate_->ld_H;
+    o.lq_H = estimate_->lq_H;
+  }
+  return o;
+}
+
+void Eemf::injection(double& ud_V, double& uq_V) const {
+  ud_V = inj_g_;
+  uq_V = inj_d_;
+}
+
+}  // namespace synbench::emulator::firmware

@@ -1,0 +1,69 @@
+// Extended-EMF observer (physics.md 8, thesis 2.12, 2.13, Sec. 6.2.3): in the estimated frame
+// e_g = u_g - (Rs + L'd p) i_g + w Lq i_d, e_d = u_d - (Rs + L'd p) i_d - w Lq i_g; the angle
+// error atan2(-e_g, e_d) drives a PI tracking observer (5 Hz) whose integral is the angle.
+// Three sources of Rs, L'd, Lq as in the thesis: constant (Ld = 0.65 H, Lq = 0.2 H), the
+// flux-map tables (optionally deformed, thesis 4.1 and 4.2), or RLS identification excited by
+// PRBS voltage injection on both axes.
+#pragma once
+
+#include <optional>
+
+#include "emulator/firmware/estimators/estimator.hpp"
+#include "emulator/firmware/estimators/rls.hpp"
+#include "emulator/firmware/estimators/tracking_observer.hpp"
+#include "emulator/firmware/pi.hpp"
+#include "emulator/flux_map.hpp"
+#include "emulator/twin_config.hpp"
+
+namespace synbench::emulator::firmware {
+
+enum class EemfModel { constant, lut, rls };
+
+struct EemfParams {
+  double ts_s = 1e-4;
+  EemfModel model = EemfModel::constant;
+  double rs_ohm = 9.68;                 // constant Rs of the const and LUT variants
+  double ld_H = 0.65, lq_H = 0.2;       // constant variant (Sec. 6.2.3)
+  FluxAxisParams flux_d{0.670, 1.30, 0.026, -0.647};  // LUT variant: the drive's flux maps
+  FluxAxisParams flux_q{0.382, 0.11, 0.081, -0.0085};
+  double lut_ld_scale = 1.0;            // kd of the table deformation L = k f(i / k) (4.1)
+  double lut_lq_scale = 1.0;            // kq (4.2)
+  double observer_bandwidth_Hz = 5.0;   // Sec. 6.2.3
+  double emf_filter_s = 5e-3;           // [assumed] low-pass on e before the angle error
+  double rls_forgetting = 0.99;         // Sec. 6.2.3
+  double rls_p0 = 1e5;
+  double rls_sample_s = 1e-3;           // [assumed] RLS sample period (a multiple of ts_s)
+  double rls_estimate_filter_s = 0.2;   // [assumed] low-pass on the estimates the observer uses
+  double prbs_voltage_V = 20.0;         // Sec. 6.2.3
+  double prbs_bit_s = 0.01;
+};
+
+class Eemf final : public Estimator {
+ public:
+  explicit Eemf(const EemfParams& p);
+  void update(const EstimatorInput& in) override;
+  EstimatorOutput output() const override;
+  void injection(double& ud_V, double& uq_V) const override;
+  void align(double theta_e_rad, double omega_e_rad_s) override { obs_.reset(theta_e_rad, omega_e_rad_s); }
+
+ private:
+  void inductances(double ig, double id, double& ld_dyn, double& lq_static) const;
+
+  EemfParams p_;
+  FluxAxis fd_, fq_;
+  TrackingObserver obs_;
+  LowPass eg_f_, ed_f_, ig_f_, id_f_;
+  double ig_prev_ = 0, id_prev_ = 0;
+  bool have_prev_ = false;
+  // RLS and its excitation.
+  std::optional<StatorRls> rls_;
+  std::optional<StatorEstimate> estimate_;
+  Prbs5 prbs_g_{0b10011}, prbs_d_{0b01101};
+  double inj_g_ = 0, inj_d_ = 0;
+  int rls_every_ = 10, rls_count_ = 0;
+  bool rls_have_prev_ = false;
+  double rls_ig0_ = 0, rls_id0_ = 0;
+  double rls_ug_sum_ = 0, rls_ud_sum_ = 0, rls_ig_sum_ = 0, rls_id_sum_ = 0;
+};
+
+}  // namespace synbench::emulator::firmware

@@ -1,0 +1,31 @@
+// Below its minimum speed an EEMF observer hands the angle to another source — HFI or the
+// encoder — as the thesis did below 500 rpm; it keeps running aligned to that source, so it
+// takes over without a jump when the speed rises again. It takes over a hysteresis below the
+// minimum speed (so a point at the minimum speed runs on it) and hands back two below.
+#pragma once
+
+#include <memory>
+
+#include "emulator/firmware/estimators/estimator.hpp"
+
+namespace synbench::emulator::firmware {
+
+class LowSpeedHandover final : public Estimator {
+ public:
+  // `fallback` null means the encoder.
+  LowSpeedHandover(std::unique_ptr<Estimator> main, std::unique_ptr<Estimator> fallback,
+                   double min_speed_rad_s, double hysteresis_rad_s);
+  void update(const EstimatorInput& in) override;
+  EstimatorOutput output() const override;
+  void injection(double& ud_V, double& uq_V) const override;
+  void fundamental(double& id_A, double& iq_A) const override;
+  bool main_active() const { return main_active_; }
+
+ private:
+  std::unique_ptr<Estimator> main_, fallback_;
+  double min_, hyst_;
+  bool main_active_ = false;
+  EstimatorOutput fallback_out_;
+};
+
+}  // namespace synbench::emulator::firmware
