@@ -1,5 +1,6 @@
-// Benchmark: wall time of one 100 us twin step, closed loop with encoder FOC, at a steady
-// operating point. Target (issue "Foundation"): <= 0.5 us per step, i.e. >= 200x real time.
+// Benchmark: wall time of one 100 us twin step, closed loop, at a steady operating point, per
+// position source. Targets: encoder FOC <= 0.5 us per step (>= 200x real time, issue
+// "Foundation"); EKF-RS <= 1 us, stretch 0.5 us (issue "Sensorless estimators").
 #include <benchmark/benchmark.h>
 
 #include "drivers/modes.hpp"
@@ -7,12 +8,14 @@
 
 namespace {
 
+using synbench::drivers::Estimator;
 using synbench::drivers::Pwm;
 using synbench::emulator::Twin;
 using synbench::emulator::TwinConfig;
 
-void run_to_point(Twin& t, double speed, double load, double angle, Pwm pwm) {
+void run_to_point(Twin& t, double speed, double load, double angle, Pwm pwm, Estimator e) {
   t.synrm_drive().set_pwm(pwm);
+  t.synrm_drive().set_estimator(e);
   t.synrm_drive().set_angle_deg(angle);
   t.synrm_drive().set_speed_rpm(speed);
   t.synrm_drive().enable(true);
@@ -22,17 +25,22 @@ void run_to_point(Twin& t, double speed, double load, double angle, Pwm pwm) {
   t.run_steps(15000);
 }
 
-void BM_TwinStep(benchmark::State& state, Pwm pwm) {
+void BM_TwinStep(benchmark::State& state, Pwm pwm, Estimator e) {
   Twin t{TwinConfig{}};
-  run_to_point(t, 700, 2.5, 52, pwm);
+  run_to_point(t, 700, 2.5, 52, pwm, e);
   for (auto _ : state) t.step();
   state.counters["real_time_factor"] =
       benchmark::Counter(static_cast<double>(state.iterations()) * t.step_s(),
                          benchmark::Counter::kIsRate);
 }
 
-BENCHMARK_CAPTURE(BM_TwinStep, encoder_capwm, Pwm::capwm);
-BENCHMARK_CAPTURE(BM_TwinStep, encoder_aspwm, Pwm::aspwm);
+BENCHMARK_CAPTURE(BM_TwinStep, encoder_capwm, Pwm::capwm, Estimator::encoder);
+BENCHMARK_CAPTURE(BM_TwinStep, encoder_aspwm, Pwm::aspwm, Estimator::encoder);
+BENCHMARK_CAPTURE(BM_TwinStep, ekf_basic_aspwm, Pwm::aspwm, Estimator::ekf_basic);
+BENCHMARK_CAPTURE(BM_TwinStep, ekf_rs_aspwm, Pwm::aspwm, Estimator::ekf_rs);
+BENCHMARK_CAPTURE(BM_TwinStep, hfi_capwm, Pwm::capwm, Estimator::hfi);
+BENCHMARK_CAPTURE(BM_TwinStep, eemf_lut_capwm, Pwm::capwm, Estimator::eemf_lut);
+BENCHMARK_CAPTURE(BM_TwinStep, eemf_rls_capwm, Pwm::capwm, Estimator::eemf_rls);
 
 }  // namespace
 
