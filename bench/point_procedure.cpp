@@ -120,8 +120,9 @@ void PointProcedure::tick(double now_s) {
     case PointPhase::stop: {
       // Step two once the load torque is gone: speed to zero; step three: disable.
       const bool timed_out = now_s - t_phase_ > opt_.stop_timeout_s;
-      if (lt.torque_Nm < 0.05 || timed_out) dev_.synrm->set_speed_rpm(0.0);
-      if ((std::fabs(st.speed_rpm) < opt_.stop_speed_rpm && lt.torque_Nm < 0.05) || timed_out ||
+      const bool load_gone = std::fabs(lt.torque_Nm) < 0.05;
+      if (load_gone || timed_out) dev_.synrm->set_speed_rpm(0.0);
+      if ((std::fabs(st.speed_rpm) < opt_.stop_speed_rpm && load_gone) || timed_out ||
           st.state == drivers::DriveState::faulted) {
         dev_.synrm->enable(false);
         dev_.load->enable(false);

@@ -15,9 +15,10 @@ class DcBus {
   double voltage_V() const { return u_V_; }
   bool brake_on() const { return brake_on_; }
 
-  // dU/dt for a net load current `i_load_A` (inverter inputs minus returns).
-  double derivative(double u_V, double i_load_A) const {
-    const double i_src = std::max(0.0, (p_.source_V - u_V) / p_.source_ohm);
+  // dU/dt for a net load current `i_load_A` (inverter inputs minus returns); `surge_V` raises
+  // the source (a fault hook).
+  double derivative(double u_V, double i_load_A, double surge_V = 0.0) const {
+    const double i_src = std::max(0.0, (p_.source_V + surge_V - u_V) / p_.source_ohm);
     const double i_brake = brake_on_ ? u_V / p_.brake_ohm : 0.0;
     return (i_src - i_load_A - i_brake) / p_.capacitance_F;
   }

@@ -79,7 +79,7 @@ Twin::Rates Twin::evaluate(const PlantState& x, double ua, double ub, bool gates
   const double p_cu_g = 1.5 * cfg_.load.rs_ohm * x.load_iq_A * x.load_iq_A;
   r.idcm_A = (r.pac_W + p_inv_m) / x.udc_V;
   r.idcg_A = (tl * wm - p_cu_g - p_inv_g) / x.udc_V;
-  r.dx.udc_V = bus_.derivative(x.udc_V, r.idcm_A - r.idcg_A);
+  r.dx.udc_V = bus_.derivative(x.udc_V, r.idcm_A - r.idcg_A, faults_.source_offset_V);
   return r;
 }
 
@@ -142,7 +142,7 @@ void Twin::step() {
   // Both drives sample and compute the command for the next period (one period of delay).
   const double sigma = cfg_.firmware.current_noise_sigma_A;
   firmware::DriveSample sample;
-  sample.ia_A = i_ph[0] + sigma * noise_.gauss();
+  sample.ia_A = i_ph[0] + sigma * noise_.gauss() + faults_.phase_a_sensor_offset_A;
   sample.ib_A = i_ph[1] + sigma * noise_.gauss();
   sample.encoder_count = static_cast<std::int64_t>(std::floor(x_.angle_rad / (2.0 * kPi) * counts_per_rev_));
   sample.udc_V = udc;

@@ -39,6 +39,13 @@ struct PlantSnapshot {
   bool brake_on = false;
 };
 
+// Faults a test injects into the plant (the twin's physical fault hooks; the Modbus link faults
+// live with the register server).
+struct PlantFaults {
+  double source_offset_V = 0;          // mains surge on the rectified source
+  double phase_a_sensor_offset_A = 0;  // current-sensor fault on phase a
+};
+
 class Twin {
  public:
   explicit Twin(const TwinConfig& config);
@@ -63,6 +70,9 @@ class Twin {
   std::optional<drivers::TruthWindow> truth_window() const { return truth_; }
 
   PlantSnapshot snapshot() const;
+  PlantFaults& faults() { return faults_; }
+  // Sets the winding temperature (a cooling failure's result, or a test's starting point).
+  void set_winding_temp_C(double t) { thermal_.set_temp_C(t); }
   const PlantState& state() const { return x_; }
   const SynrmModel& synrm_model() const { return synrm_; }
   // The last MCIDC sample (none when the active vector was too short or the gates are off).
@@ -89,6 +99,7 @@ class Twin {
   double counts_per_rev_;
   double load_kt_;
 
+  PlantFaults faults_;
   PlantState x_;
   std::uint64_t steps_ = 0;
   firmware::DriveOutput applied_;  // the command in force during this period

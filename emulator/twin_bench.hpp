@@ -21,6 +21,13 @@ class TwinBench {
   drivers::BenchDevices devices();
   drivers::Clock& clock();
 
+  // Cuts (or restores) the link to every device: calls fail with errc::disconnected, and after
+  // `watchdog_timeout_s` of silence both drives stop on their own watchdog and latch it, as the
+  // firmware behind a real link does.
+  void set_link_down(bool down);
+  bool link_down() const;
+  static constexpr double kWatchdogTimeout_s = 0.5;
+
  private:
   struct Adapters;
   Twin twin_;

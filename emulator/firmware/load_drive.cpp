@@ -18,6 +18,7 @@ std::error_code LoadDriveFirmware::enable(bool on) {
   if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!on) {
     torque_cmd_Nm_ = 0;
+    runaway_Nm_ = 0;
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
     return {};
   }
@@ -28,6 +29,10 @@ std::error_code LoadDriveFirmware::enable(bool on) {
 
 std::error_code LoadDriveFirmware::set_torque_Nm(double torque_Nm) {
   if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
+  if (torque_Nm == 0.0 && runaway_Nm_ != 0.0) {
+    runaway_Nm_ = 0.0;
+    torque_cmd_Nm_ = 0.0;  // the faulty reference is dropped, not ramped out
+  }
   if (!std::isfinite(torque_Nm) || torque_Nm < 0 ||
       torque_Nm > kt_ * cfg_.load.current_limit_A)
     return make_error_code(errc::invalid_argument);
@@ -67,6 +72,8 @@ double LoadDriveFirmware::control(double iq_measured_A) {
   } else {
     torque_cmd_Nm_ = 0;
   }
+  if (runaway_Nm_ != 0 && state_ == drivers::DriveState::running && torque_set_Nm_ > 0)
+    torque_cmd_Nm_ = -runaway_Nm_;
   f_iq_.update(iq_measured_A);
   if (window_left_ > 0) {
     w_iq_.add(iq_measured_A);

@@ -24,6 +24,10 @@ class LoadDriveFirmware {
   // Ordered stop on the drive's own initiative (watchdog): ramps the torque to zero, then
   // latches `fault`.
   void stop_and_latch(drivers::Fault fault);
+  // Fault hook: a wrong sign in the torque reference chain. While a non-zero torque is
+  // commanded the drive motors the shaft with `torque_Nm` instead of braking; a zero command
+  // (the ordered stop's first step) or a disable ends it.
+  void inject_runaway(double torque_Nm) { runaway_Nm_ = torque_Nm; }
 
   // One PWM period: returns the current reference (braking magnitude, A).
   double control(double iq_measured_A);
@@ -40,7 +44,7 @@ class LoadDriveFirmware {
   drivers::DriveState state_ = drivers::DriveState::disabled;
   drivers::Fault fault_ = drivers::Fault::none;
   drivers::Fault pending_fault_ = drivers::Fault::none;
-  double torque_set_Nm_ = 0, torque_cmd_Nm_ = 0;
+  double torque_set_Nm_ = 0, torque_cmd_Nm_ = 0, runaway_Nm_ = 0;
   LowPass f_iq_;
   std::int64_t window_left_ = 0;
   WindowStats w_iq_;

@@ -1,0 +1,80 @@
+// Safety supervisor of the bench: checked every tick, whatever a sweep is doing. On a limit
+// violation, a device fault or a lost link it brings the bench to the ordered stop — load torque
+// to zero, then speed to zero, then both drives disabled — and latches the reason until an
+// explicit reset; an E-stop disables both drives at once. Pure logic on the time it is given.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <system_error>
+
+#include "drivers/devices.hpp"
+
+namespace synbench::bench {
+
+struct SafetyLimits {
+  double max_speed_rpm = 1650.0;
+  double max_current_A = 5.0;
+  double max_udc_V = 445.0;
+  double min_udc_V = 320.0;      // checked only while a drive runs
+  double max_temp_C = 110.0;
+  double link_timeout_s = 0.5;   // telemetry reads failing this long is a lost link
+  double stop_load_timeout_s = 1.0;   // step one of the ordered stop; then the load is disabled
+  double stop_speed_timeout_s = 10.0; // step two, then disable regardless
+  double stopped_speed_rpm = 20.0;
+};
+
+// Why the bench stopped; `fault` names it with the device fault vocabulary.
+struct SafetyTrip {
+  drivers::Fault fault = drivers::Fault::none;
+  std::string detail;   // e.g. "speed 1712 rpm > 1650 rpm"
+  double at_s = 0;      // when it was detected
+};
+
+enum class SafetyPhase { normal, stopping_load, stopping_speed, stopped, estopped };
+
+class SafetySupervisor {
+ public:
+  using EventSink = std::function<void(const std::string& kind, const std::string& message)>;
+
+  SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits, EventSink sink = {});
+
+  // Reads telemetry, checks limits, advances an ordered stop. Returns the telemetry it read (or
+  // nothing when the link is down) so a sweep need not read twice.
+  void tick(double now_s);
+  const std::optional<drivers::SynrmTelemetry>& synrm() const { return synrm_; }
+  const std::optional<drivers::LoadTelemetry>& load() const { return load_; }
+
+  // Immediate disable of both drives; latched like any trip.
+  void estop(double now_s, const std::string& why = "E-stop");
+  // Explicit reset: clears the latch and the devices' latched faults. Refused while an ordered
+  // stop is still running. Never restarts anything.
+  std::error_code reset(double now_s);
+
+  bool tripped() const { return trip_.has_value(); }
+  bool may_command() const { return !trip_; }
+  SafetyPhase phase() const { return phase_; }
+  const std::optional<SafetyTrip>& trip() const { return trip_; }
+  // Time from detection to both drives disabled, once the stop has completed.
+  std::optional<double> stop_duration_s() const { return stop_duration_s_; }
+
+ private:
+  void raise(double now_s, drivers::Fault fault, std::string detail);
+  void advance_stop(double now_s);
+  void disable_all();
+
+  drivers::BenchDevices dev_;
+  SafetyLimits lim_;
+  EventSink sink_;
+  std::optional<drivers::SynrmTelemetry> synrm_;
+  std::optional<drivers::LoadTelemetry> load_;
+  double last_good_read_s_ = 0;
+  bool seen_good_read_ = false;
+  SafetyPhase phase_ = SafetyPhase::normal;
+  double phase_since_s_ = 0;
+  std::optional<SafetyTrip> trip_;
+  std::optional<double> stop_duration_s_;
+};
+
+}  // namespace synbench::bench
