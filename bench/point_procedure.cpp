@@ -66,6 +66,16 @@ void PointProcedure::tick(double now_s) {
         phase_ = PointPhase::failed;
         return;
       }
+      if (opt_.continue_running && st.state == drivers::DriveState::running) {
+        // Retarget a running bench: everything at once, then let the gate judge.
+        if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
+        if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
+        if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+        if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
+        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        enter(PointPhase::load_up, now_s);
+        return;
+      }
       if (!check(dev_.load->set_torque_Nm(0.0), "setting load torque")) return;
       if (!check(dev_.load->enable(true), "enabling the load drive")) return;
       if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
@@ -99,10 +109,33 @@ void PointProcedure::tick(double now_s) {
       const bool timed_out = now_s - t_phase_ > opt_.settle_timeout_s;
       if (settled || timed_out) {
         if (timed_out && !settled) record_.unstable = true;
+        if (opt_.thermal && std::fabs(st.temp_C - opt_.thermal->target_C) > opt_.thermal->band_C) {
+          if (t_thermal_ < 0) t_thermal_ = now_s;
+          if (now_s - t_thermal_ <= opt_.thermal->timeout_s) {
+            // Warm with load or cool unloaded, then come back and settle again.
+            const bool cold = st.temp_C < opt_.thermal->target_C;
+            if (!check(dev_.load->set_torque_Nm(cold ? opt_.thermal->warmup_load_Nm : 0.0),
+                       "setting the thermal-conditioning load"))
+              return;
+            enter(PointPhase::thermal, now_s);
+            return;
+          }
+          record_.unstable = true;  // measured outside the thermal window after the timeout
+        }
         if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
         t_window_ = now_s;
         record_.settle_s = now_s - t_start_;
         enter(PointPhase::measure, now_s);
+      }
+      return;
+    }
+    case PointPhase::thermal: {
+      // Inside the band with half a band of margin, so the window does not end outside it.
+      const auto& th = *opt_.thermal;
+      const bool inside = std::fabs(st.temp_C - th.target_C) < 0.5 * th.band_C;
+      if (inside || now_s - t_thermal_ > th.timeout_s) {
+        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        enter(PointPhase::load_up, now_s);
       }
       return;
     }

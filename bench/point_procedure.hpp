@@ -4,6 +4,7 @@
 // It never sleeps; run_point() below is the loop that waits on a Clock.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -33,10 +34,20 @@ struct PointOptions {
   double stop_timeout_s = 30.0;
   double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
   bool ordered_stop_after = true;
+  // In a sweep the drives stay running between points: when the SynRM drive already runs, the
+  // new setpoints are commanded together and the gate decides when the bench has settled.
+  bool continue_running = false;
   SteadyStateBands gate;
+  // Thermal precondition (Sec. 6.3.2): measure only within target +/- band; a cold machine is
+  // warmed with `warmup_load_Nm`, a hot one cooled unloaded; after `timeout_s` the point is
+  // measured anyway and flagged unstable.
+  struct Thermal {
+    double target_C = 50.0, band_C = 5.0, warmup_load_Nm = 3.5, timeout_s = 1800.0;
+  };
+  std::optional<Thermal> thermal;
 };
 
-enum class PointPhase { start, spin_up, load_up, settle, measure, stop, done, failed };
+enum class PointPhase { start, spin_up, load_up, settle, thermal, measure, stop, done, failed };
 
 class PointProcedure {
  public:
@@ -62,7 +73,7 @@ class PointProcedure {
   PointOptions opt_;
   SteadyStateGate gate_;
   PointPhase phase_ = PointPhase::start;
-  double t_start_ = 0, t_phase_ = 0, t_window_ = 0;
+  double t_start_ = 0, t_phase_ = 0, t_window_ = 0, t_thermal_ = -1;
   bool has_record_ = false;
   PointRecord record_;
   std::string error_;

@@ -70,3 +70,46 @@ TEST(PointProcedure, RefusesToStartOnALatchedFault) {
 
 }  // namespace
 }  // namespace synbench::bench
+
+namespace synbench::bench {
+namespace {
+
+TEST(PointProcedure, ChainedPointsRetargetARunningBenchAndAgreeWithStandalone) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  PointOptions first;
+  first.ordered_stop_after = false;
+  const auto a = run_point(bench.devices(), bench.clock(), request(700, 2.5, 52), first);
+  ASSERT_EQ(a.phase(), PointPhase::done) << a.error();
+  PointOptions next = first;
+  next.continue_running = true;
+  const auto b = run_point(bench.devices(), bench.clock(), request(700, 2.5, 60), next);
+  ASSERT_EQ(b.phase(), PointPhase::done) << b.error();
+  EXPECT_LT(b.record().settle_s, a.record().settle_s) << "no spin-up between chained points";
+
+  emulator::TwinBench fresh{emulator::TwinConfig{}};
+  const auto alone = run_point(fresh.devices(), fresh.clock(), request(700, 2.5, 60), PointOptions{});
+  EXPECT_NEAR(b.record().pdcm_W, alone.record().pdcm_W, 0.5);
+  EXPECT_NEAR(b.record().im_A, alone.record().im_A, 0.005);
+}
+
+TEST(PointProcedure, ThermalPreconditionWarmsAColdMachineBeforeMeasuring) {
+  emulator::TwinConfig cfg;
+  cfg.thermal.initial_C = 38.0;
+  cfg.thermal.capacity_J_per_K = 400.0;  // ten times faster than the real winding
+  emulator::TwinBench bench(cfg);
+  PointOptions opt;
+  opt.thermal = PointOptions::Thermal{};
+  const auto p = run_point(bench.devices(), bench.clock(), request(700, 1.0, 56), opt);
+  ASSERT_EQ(p.phase(), PointPhase::done) << p.error();
+  EXPECT_FALSE(p.record().unstable);
+  EXPECT_NEAR(p.record().temp_C, 50.0, 5.0);
+  EXPECT_GT(p.record().temp_C, 47.0);
+  EXPECT_GT(p.record().settle_s, 10.0) << "it waited for the winding to warm";
+  EXPECT_NEAR(p.record().load_Nm, 1.0, 1e-12);
+  ASSERT_TRUE(p.record().truth);
+  EXPECT_NEAR(p.record().pm_W, p.record().truth->pm_W, 0.01 * p.record().truth->pm_W)
+      << "measured at the point's own load, not the warm-up load";
+}
+
+}  // namespace
+}  // namespace synbench::bench
