@@ -1,0 +1,36 @@
+// Messages of the database's error category.
+#include "db/error.hpp"
+
+namespace synbench::db {
+namespace {
+
+class Category final : public std::error_category {
+ public:
+  const char* name() const noexcept override { return "synbench.db"; }
+  std::string message(int ev) const override {
+    switch (static_cast<errc>(ev)) {
+      case errc::ok: return "ok";
+      case errc::sqlite: return "SQLite error";
+      case errc::busy: return "database is locked by another connection";
+      case errc::io: return "cannot read or write the database file";
+      case errc::corrupt: return "database file is damaged or not a database";
+      case errc::schema_too_new: return "database was written by a newer synbench";
+      case errc::not_synbench: return "not a synbench database";
+      case errc::not_found: return "no such sweep";
+      case errc::duplicate_point: return "point already stored";
+      case errc::invalid_argument: return "invalid argument";
+      case errc::invalid_transition: return "sweep state change refused";
+      case errc::bad_record: return "stored row cannot be read back as a record";
+    }
+    return "unknown database error";
+  }
+};
+
+}  // namespace
+
+const std::error_category& error_category() noexcept {
+  static const Category category;
+  return category;
+}
+
+}  // namespace synbench::db

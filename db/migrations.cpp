@@ -1,0 +1,175 @@
+// synbench's schema migrations and the loop that applies them.
+#include "db/migrations.hpp"
+
+#include <array>
+#include <stdexcept>
+#include <string>
+
+#include "db/sqlite.hpp"
+
+namespace synbench::db {
+namespace {
+
+// Version 1: sweeps, points, events. STRICT tables, so a value of the wrong type is refused.
+// Point columns carry experiment.md Sec. 2.5's names in the record's order (tests/db checks them
+// against bench::to_json). The record's numbers are declared ANY with a typeof CHECK instead of
+// REAL because REAL affinity stores integral values as integers and so turns -0.0 into 0.0; ANY
+// keeps the exact double. They are nullable: optional fields are NULL when absent, and a NULL in a
+// required field is a NaN (SQLite cannot store NaN). Estimator and PWM names are not CHECKed, so
+// a new estimator needs no table rebuild; the store validates them when reading.
+constexpr std::string_view kSchemaV1 = R"sql(
+CREATE TABLE sweeps (
+  id                INTEGER PRIMARY KEY,
+  name              TEXT    NOT NULL,
+  created_at        TEXT    NOT NULL,
+  started_at        TEXT,
+  finished_at       TEXT,
+  state             TEXT    NOT NULL DEFAULT 'created'
+                    CHECK (state IN ('created','running','paused','completed','aborted','faulted')),
+  plan_json         TEXT,
+  software_version  TEXT    NOT NULL,
+  profiles_json     TEXT,
+  bench_config_json TEXT,
+  calibration_json  TEXT,
+  total_points      INTEGER NOT NULL CHECK (total_points >= 0),
+  last_error        TEXT
+) STRICT;
+
+CREATE TABLE points (
+  id               INTEGER PRIMARY KEY,
+  sweep_id         INTEGER NOT NULL REFERENCES sweeps(id) ON DELETE CASCADE,
+  point_index      INTEGER NOT NULL CHECK (point_index >= 0),
+  speed_rpm        ANY     CHECK (typeof(speed_rpm) IN ('real', 'null')),
+  load_Nm          ANY     CHECK (typeof(load_Nm) IN ('real', 'null')),
+  angle_deg        ANY     CHECK (typeof(angle_deg) IN ('real', 'null')),
+  estimator        TEXT    NOT NULL,
+  pwm              TEXT    NOT NULL,
+  speed_meas_rpm   ANY     CHECK (typeof(speed_meas_rpm) IN ('real', 'null')),
+  im_A             ANY     CHECK (typeof(im_A) IN ('real', 'null')),
+  id_A             ANY     CHECK (typeof(id_A) IN ('real', 'null')),
+  iq_A             ANY     CHECK (typeof(iq_A) IN ('real', 'null')),
+  ud_V             ANY     CHECK (typeof(ud_V) IN ('real', 'null')),
+  uq_V             ANY     CHECK (typeof(uq_V) IN ('real', 'null')),
+  udc_V            ANY     CHECK (typeof(udc_V) IN ('real', 'null')),
+  idcm_A           ANY     CHECK (typeof(idcm_A) IN ('real', 'null')),
+  idcg_A           ANY     CHECK (typeof(idcg_A) IN ('real', 'null')),
+  pdcm_W           ANY     CHECK (typeof(pdcm_W) IN ('real', 'null')),
+  pdcg_W           ANY     CHECK (typeof(pdcg_W) IN ('real', 'null')),
+  pm_W             ANY     CHECK (typeof(pm_W) IN ('real', 'null')),
+  efficiency       ANY     CHECK (typeof(efficiency) IN ('real', 'null')),
+  pos_err_min_deg  ANY     CHECK (typeof(pos_err_min_deg) IN ('real', 'null')),
+  pos_err_mean_deg ANY     CHECK (typeof(pos_err_mean_deg) IN ('real', 'null')),
+  pos_err_max_deg  ANY     CHECK (typeof(pos_err_max_deg) IN ('real', 'null')),
+  speed_err_rpm    ANY     CHECK (typeof(speed_err_rpm) IN ('real', 'null')),
+  ld_est_H         ANY     CHECK (typeof(ld_est_H) IN ('real', 'null')),
+  lq_est_H         ANY     CHECK (typeof(lq_est_H) IN ('real', 'null')),
+  rs_est_ohm       ANY     CHECK (typeof(rs_est_ohm) IN ('real', 'null')),
+  ld_err_pct       ANY     CHECK (typeof(ld_err_pct) IN ('real', 'null')),
+  lq_err_pct       ANY     CHECK (typeof(lq_err_pct) IN ('real', 'null')),
+  rs_err_pct       ANY     CHECK (typeof(rs_err_pct) IN ('real', 'null')),
+  temp_C           ANY     CHECK (typeof(temp_C) IN ('real', 'null')),
+  window_s         ANY     CHECK (typeof(window_s) IN ('real', 'null')),
+  samples          INTEGER NOT NULL CHECK (samples >= 0),
+  settle_s         ANY     CHECK (typeof(settle_s) IN ('real', 'null')),
+  voltage_limited  INTEGER NOT NULL CHECK (voltage_limited IN (0, 1)),
+  unstable         INTEGER NOT NULL CHECK (unstable IN (0, 1)),
+  fault            TEXT,
+  truth_json       TEXT,
+  measured_at      TEXT    NOT NULL,
+  UNIQUE (sweep_id, point_index)
+) STRICT;
+
+CREATE TABLE events (
+  id       INTEGER PRIMARY KEY,
+  sweep_id INTEGER REFERENCES sweeps(id) ON DELETE CASCADE,
+  at       TEXT    NOT NULL,
+  kind     TEXT    NOT NULL CHECK (kind IN ('fault','state','log')),
+  message  TEXT    NOT NULL
+) STRICT;
+CREATE INDEX events_by_sweep ON events (sweep_id, id);
+)sql";
+
+constexpr std::array kMigrations{
+    Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
+};
+
+struct Header {
+  int user_version = 0;
+  std::int64_t application_id = 0;
+  std::int64_t objects = 0;  // tables, indexes, ... already in the file
+};
+
+Result<std::int64_t> scalar(sqlite3* db, std::string_view sql) {
+  auto st = detail::Statement::prepare(db, sql);
+  if (!st) return st.error();
+  const int rc = st->step();
+  if (rc != SQLITE_ROW) return detail::sqlite_error(db, rc, "reading the schema version");
+  return st->integer(0);
+}
+
+Result<Header> read_header(sqlite3* db) {
+  Header h;
+  auto v = scalar(db, "PRAGMA user_version");
+  if (!v) return v.error();
+  auto a = scalar(db, "PRAGMA application_id");
+  if (!a) return a.error();
+  auto n = scalar(db, "SELECT count(*) FROM sqlite_schema");
+  if (!n) return n.error();
+  h.user_version = static_cast<int>(*v);
+  h.application_id = *a;
+  h.objects = *n;
+  return h;
+}
+
+}  // namespace
+
+std::span<const Migration> migrations() noexcept { return kMigrations; }
+
+int schema_version() noexcept { return kMigrations.back().version; }
+
+namespace detail {
+
+Status migrate(sqlite3* db, std::span<const Migration> steps) {
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    if (steps[i].version != static_cast<int>(i) + 1)
+      throw std::logic_error("db migrations must be numbered 1, 2, 3, ... in order");
+  const int latest = steps.empty() ? 0 : steps.back().version;
+
+  auto tx_statements = TransactionStatements::prepare(db);
+  if (!tx_statements) return tx_statements.error();
+  for (;;) {
+    Transaction tx(db, *tx_statements);
+    if (auto s = tx.begin(); !s) return s;
+    auto h = read_header(db);
+    if (!h) return h.error();
+
+    if (h->user_version > latest)
+      return make_error(errc::schema_too_new,
+                        "database schema version " + std::to_string(h->user_version) +
+                            " is newer than this synbench understands (up to " +
+                            std::to_string(latest) + "); use a newer synbench to open it");
+    // A synbench file carries our application_id from step 1 on. A file without it is only ours
+    // to initialise if it is empty (a brand-new file, or one whose first step was rolled back).
+    const bool ours = h->application_id == kApplicationId;
+    const bool empty = h->application_id == 0 && h->user_version == 0 && h->objects == 0;
+    if (!ours && !empty)
+      return make_error(errc::not_synbench,
+                        "the file is a SQLite database of another application (application_id " +
+                            std::to_string(h->application_id) + ", user_version " +
+                            std::to_string(h->user_version) + ")");
+    if (h->user_version == latest) return tx.commit();  // up to date: ends the read
+
+    const Migration& step = steps[static_cast<std::size_t>(h->user_version)];
+    const std::string where = "migration to schema version " + std::to_string(step.version);
+    if (auto s = exec(db, std::string(step.sql).c_str(), where); !s) return s;
+    // Both pragmas are written in the transaction, so a crash leaves the old version or the new,
+    // never the new tables under the old number.
+    const std::string mark = "PRAGMA user_version = " + std::to_string(step.version) +
+                             "; PRAGMA application_id = " + std::to_string(kApplicationId) + ";";
+    if (auto s = exec(db, mark.c_str(), where); !s) return s;
+    if (auto s = tx.commit(); !s) return s;
+  }
+}
+
+}  // namespace detail
+}  // namespace synbench::db

@@ -1,0 +1,613 @@
+// The SQLite store: opening and configuring the connection, sweeps, points, events.
+#include "db/store.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <limits>
+#include <stdexcept>
+
+#include "db/migrations.hpp"
+#include "db/point_columns.hpp"
+#include "db/sqlite.hpp"
+
+namespace synbench::db {
+
+using detail::Statement;
+using detail::Transaction;
+
+namespace {
+
+// Wall-clock UTC with milliseconds, ISO 8601: sorts as text and SQLite's date functions read it.
+std::string now_utc() {
+  using namespace std::chrono;
+  const auto now = system_clock::now();
+  const auto ms = duration_cast<milliseconds>(now.time_since_epoch()).count() % 1000;
+  const std::time_t t = system_clock::to_time_t(now);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  char out[40];
+  std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms));
+  return out;
+}
+
+std::optional<std::string> json_text(const nlohmann::ordered_json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.dump();
+}
+
+Result<nlohmann::ordered_json> json_column(const Statement& st, int i, std::string_view what) {
+  if (st.is_null(i)) return nlohmann::ordered_json(nullptr);
+  auto j = nlohmann::ordered_json::parse(st.text(i), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) return make_error(errc::bad_record, std::string(what) + " is not valid JSON");
+  return j;
+}
+
+bool finished(SweepState s) {
+  return s == SweepState::completed || s == SweepState::aborted || s == SweepState::faulted;
+}
+
+// The record's columns as SQL lists, generated from the one column table.
+std::string record_column_list() {
+  std::string s;
+  for (const auto& c : detail::kRecordColumns) {
+    s += c.name;
+    s += ", ";
+  }
+  return s;
+}
+
+std::string insert_point_sql() {
+  std::string sql = "INSERT INTO points (sweep_id, point_index, " + record_column_list() +
+                    "truth_json, measured_at) VALUES (?, ?";
+  for (std::size_t i = 0; i < detail::kRecordColumns.size() + 2; ++i) sql += ", ?";
+  return sql + ")";
+}
+
+std::string select_points_sql() {
+  return "SELECT point_index, " + record_column_list() +
+         "truth_json FROM points WHERE sweep_id = ? ORDER BY point_index";
+}
+
+constexpr std::string_view kSweepColumns =
+    "SELECT s.id, s.name, s.created_at, s.started_at, s.finished_at, s.state, s.plan_json, "
+    "s.software_version, s.profiles_json, s.bench_config_json, s.calibration_json, "
+    "s.total_points, s.last_error, (SELECT count(*) FROM points p WHERE p.sweep_id = s.id) "
+    "FROM sweeps s";
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+void bind_record(Statement& st, int first, const bench::PointRecord& r) {
+  int i = first;
+  for (const auto& c : detail::kRecordColumns) {
+    std::visit(Overloaded{
+                   [&](double bench::PointRecord::*m) {
+                     // NaN has no SQLite form; NULL in a required column means NaN.
+                     if (std::isnan(r.*m)) st.bind_null(i); else st.bind(i, r.*m);
+                   },
+                   [&](std::optional<double> bench::PointRecord::*m) {
+                     if (!(r.*m) || std::isnan(*(r.*m))) st.bind_null(i); else st.bind(i, *(r.*m));
+                   },
+                   [&](drivers::Estimator bench::PointRecord::*m) { st.bind(i, drivers::name(r.*m)); },
+                   [&](drivers::Pwm bench::PointRecord::*m) { st.bind(i, drivers::name(r.*m)); },
+                   [&](std::uint32_t bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m}); },
+                   [&](bool bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m ? 1 : 0}); },
+                   [&](std::optional<std::string> bench::PointRecord::*m) { st.bind(i, r.*m); },
+               },
+               c.member);
+    ++i;
+  }
+}
+
+Status read_record(const Statement& st, int first, bench::PointRecord& r) {
+  int i = first;
+  for (const auto& c : detail::kRecordColumns) {
+    Status s = std::visit(
+        Overloaded{
+            [&](double bench::PointRecord::*m) -> Status {
+              r.*m = st.is_null(i) ? std::numeric_limits<double>::quiet_NaN() : st.real(i);
+              return {};
+            },
+            [&](std::optional<double> bench::PointRecord::*m) -> Status {
+              r.*m = st.is_null(i) ? std::nullopt : std::optional<double>(st.real(i));
+              return {};
+            },
+            [&](drivers::Estimator bench::PointRecord::*m) -> Status {
+              const auto v = drivers::parse_estimator(st.text(i));
+              if (!v) return make_error(errc::bad_record, "unknown estimator \"" + st.text(i) + "\"");
+              r.*m = *v;
+              return {};
+            },
+            [&](drivers::Pwm bench::PointRecord::*m) -> Status {
+              const auto v = drivers::parse_pwm(st.text(i));
+              if (!v) return make_error(errc::bad_record, "unknown pwm \"" + st.text(i) + "\"");
+              r.*m = *v;
+              return {};
+            },
+            [&](std::uint32_t bench::PointRecord::*m) -> Status {
+              const auto v = st.integer(i);
+              if (v < 0 || v > std::numeric_limits<std::uint32_t>::max())
+                return make_error(errc::bad_record, std::string(c.name) + " out of range");
+              r.*m = static_cast<std::uint32_t>(v);
+              return {};
+            },
+            [&](bool bench::PointRecord::*m) -> Status {
+              r.*m = st.integer(i) != 0;
+              return {};
+            },
+            [&](std::optional<std::string> bench::PointRecord::*m) -> Status {
+              r.*m = st.opt_text(i);
+              return {};
+            },
+        },
+        c.member);
+    if (!s) return s;
+    ++i;
+  }
+  return {};
+}
+
+std::string truth_text(const drivers::TruthWindow& t) {
+  // The same object as the record's JSON "truth"; nlohmann writes doubles in their shortest
+  // round-trip form, so the values come back bit for bit.
+  const nlohmann::ordered_json j = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W},     {"pfe_W", t.pfe_W},
+                                    {"pmech_W", t.pmech_W}, {"pinvm_W", t.pinvm_W}, {"pm_W", t.pm_W},
+                                    {"temp_C", t.temp_C}};
+  return j.dump();
+}
+
+Result<drivers::TruthWindow> parse_truth(const std::string& text) {
+  const auto j = nlohmann::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return make_error(errc::bad_record, "truth_json is not a JSON object");
+  drivers::TruthWindow t;
+  const std::pair<const char*, double drivers::TruthWindow::*> fields[] = {
+      {"pin_W", &drivers::TruthWindow::pin_W},     {"pcu_W", &drivers::TruthWindow::pcu_W},
+      {"pfe_W", &drivers::TruthWindow::pfe_W},     {"pmech_W", &drivers::TruthWindow::pmech_W},
+      {"pinvm_W", &drivers::TruthWindow::pinvm_W}, {"pm_W", &drivers::TruthWindow::pm_W},
+      {"temp_C", &drivers::TruthWindow::temp_C}};
+  for (const auto& [key, member] : fields) {
+    const auto it = j.find(key);
+    if (it == j.end()) return make_error(errc::bad_record, std::string("truth_json has no ") + key);
+    // JSON has no NaN or infinity; nlohmann writes them as null, which comes back as NaN.
+    if (it->is_null()) t.*member = std::numeric_limits<double>::quiet_NaN();
+    else if (it->is_number()) t.*member = it->get<double>();
+    else return make_error(errc::bad_record, std::string("truth_json.") + key + " is not a number");
+  }
+  return t;
+}
+
+}  // namespace
+
+struct Store::Impl {
+  sqlite3* db = nullptr;
+  std::filesystem::path path;
+  detail::TransactionStatements tx;
+  Statement insert_sweep, insert_event, sweep_for_update, update_sweep_state, select_sweep,
+      select_sweeps, sweep_total, sweep_exists, insert_point, select_points, select_indices,
+      select_events_of_sweep, select_events_all;
+
+  ~Impl() {
+    // Statements first: sqlite3_close_v2 would otherwise defer the close until they are gone.
+    tx = {};
+    for (auto* s : {&insert_sweep, &insert_event, &sweep_for_update, &update_sweep_state, &select_sweep,
+                    &select_sweeps, &sweep_total, &sweep_exists, &insert_point, &select_points,
+                    &select_indices, &select_events_of_sweep, &select_events_all})
+      *s = Statement();
+    sqlite3_close_v2(db);
+  }
+
+  Error fail(int rc, std::string_view what) const { return detail::sqlite_error(db, rc, what); }
+
+  Status prepare_all() {
+    const std::pair<Statement*, std::string> all[] = {
+        {&insert_sweep,
+         "INSERT INTO sweeps (name, created_at, state, plan_json, software_version, profiles_json, "
+         "bench_config_json, calibration_json, total_points) VALUES (?, ?, 'created', ?, ?, ?, ?, ?, ?)"},
+        {&insert_event, "INSERT INTO events (sweep_id, at, kind, message) VALUES (?, ?, ?, ?)"},
+        {&sweep_for_update,
+         "SELECT state, started_at, total_points, (SELECT count(*) FROM points WHERE sweep_id = ?1) "
+         "FROM sweeps WHERE id = ?1"},
+        {&update_sweep_state,
+         "UPDATE sweeps SET state = ?, started_at = ?, finished_at = ?, "
+         "last_error = coalesce(?, last_error) WHERE id = ?"},
+        {&select_sweep, std::string(kSweepColumns) + " WHERE s.id = ?"},
+        {&select_sweeps, std::string(kSweepColumns) + " ORDER BY s.id"},
+        {&sweep_total, "SELECT total_points FROM sweeps WHERE id = ?"},
+        {&sweep_exists, "SELECT 1 FROM sweeps WHERE id = ?"},
+        {&insert_point, insert_point_sql()},
+        {&select_points, select_points_sql()},
+        {&select_indices, "SELECT point_index FROM points WHERE sweep_id = ? ORDER BY point_index"},
+        {&select_events_of_sweep,
+         "SELECT id, sweep_id, at, kind, message FROM events WHERE sweep_id = ? ORDER BY id"},
+        {&select_events_all, "SELECT id, sweep_id, at, kind, message FROM events ORDER BY id"},
+    };
+    for (const auto& [st, sql] : all) {
+      auto p = Statement::prepare(db, sql);
+      if (!p) return p.error();
+      *st = std::move(*p);
+    }
+    auto t = detail::TransactionStatements::prepare(db);
+    if (!t) return t.error();
+    tx = std::move(*t);
+    return {};
+  }
+
+  // Whether the sweep exists; a database failure is an Error.
+  Result<bool> exists(std::int64_t sweep_id) {
+    Statement::Use use(sweep_exists);
+    sweep_exists.bind(1, sweep_id);
+    const int rc = sweep_exists.step();
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    return fail(rc, "looking up the sweep");
+  }
+
+  Result<Sweep> read_sweep(const Statement& st) {
+    Sweep s;
+    s.id = st.integer(0);
+    s.meta.name = st.text(1);
+    s.created_at = st.text(2);
+    s.started_at = st.opt_text(3);
+    s.finished_at = st.opt_text(4);
+    const auto state = parse_sweep_state(st.text(5));
+    if (!state) return make_error(errc::bad_record, "sweep " + std::to_string(s.id) + " has an unknown state");
+    s.state = *state;
+    const std::pair<int, nlohmann::ordered_json SweepMeta::*> json_columns[] = {
+        {6, &SweepMeta::plan}, {8, &SweepMeta::profiles}, {9, &SweepMeta::bench_config},
+        {10, &SweepMeta::calibration}};
+    for (const auto& [col, member] : json_columns) {
+      auto j = json_column(st, col, "a JSON column of sweep " + std::to_string(s.id));
+      if (!j) return j.error();
+      s.meta.*member = std::move(*j);
+    }
+    s.meta.software_version = st.text(7);
+    s.meta.total_points = st.integer(11);
+    s.last_error = st.opt_text(12);
+    s.points_stored = st.integer(13);
+    return s;
+  }
+
+  Status add_event_in_tx(std::optional<std::int64_t> sweep_id, EventKind kind, std::string_view message,
+                         std::int64_t* id) {
+    Statement::Use use(insert_event);
+    insert_event.bind(1, sweep_id);
+    insert_event.bind(2, now_utc());
+    insert_event.bind(3, name(kind));
+    insert_event.bind(4, message);
+    const int rc = insert_event.step();
+    if (rc == SQLITE_CONSTRAINT_FOREIGNKEY)
+      return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id.value_or(0)));
+    if (rc != SQLITE_DONE) return fail(rc, "recording an event");
+    if (id) *id = sqlite3_last_insert_rowid(db);
+    return {};
+  }
+};
+
+Store::Store(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Store::Store(Store&&) noexcept = default;
+Store& Store::operator=(Store&&) noexcept = default;
+Store::~Store() = default;
+
+Store::Impl& Store::impl() const {
+  if (!impl_) throw std::logic_error("db::Store used after being moved from");
+  return *impl_;
+}
+
+const std::filesystem::path& Store::path() const { return impl().path; }
+
+Result<Store> Store::open(const std::filesystem::path& path, const StoreOptions& options) {
+  // SQLite would take "" as a private temporary database, gone at close: never what is meant.
+  if (path.empty()) return make_error(errc::invalid_argument, "the database path is empty");
+  auto impl = std::make_unique<Impl>();
+  impl->path = path;
+  const std::string where = "opening " + path.string();
+  const int rc = sqlite3_open_v2(path.c_str(), &impl->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  if (rc != SQLITE_OK) return detail::sqlite_error(impl->db, rc, where);
+  sqlite3_extended_result_codes(impl->db, 1);  // tells a UNIQUE from a FOREIGN KEY failure
+  sqlite3_busy_timeout(impl->db, options.busy_timeout_ms);
+
+  // journal_mode answers with the mode it got: anything but "wal" (an in-memory database, a
+  // file system without shared memory) would silently lose the durability we promise.
+  {
+    auto st = Statement::prepare(impl->db, "PRAGMA journal_mode = WAL");
+    if (!st) return st.error();
+    const int step = st->step();
+    if (step != SQLITE_ROW) return impl->fail(step, where + ": setting WAL");
+    if (st->text(0) != "wal")
+      return make_error(errc::io, where + ": WAL journal not available (got \"" + st->text(0) + "\")");
+  }
+  // synchronous=FULL: in WAL mode the WAL is fsynced at every commit, so a committed point
+  // survives a power cut, not only a process crash (NORMAL would only promise the latter).
+  if (auto s = detail::exec(impl->db, "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON;", where); !s)
+    return s.error();
+  if (auto s = detail::migrate(impl->db, migrations()); !s)
+    return Error{s.error().code, where + ": " + s.error().message};
+  if (auto s = impl->prepare_all(); !s) return s.error();
+  return Store(std::move(impl));
+}
+
+Result<std::int64_t> Store::create_sweep(const SweepMeta& meta) {
+  auto& d = impl();
+  if (meta.name.empty()) return make_error(errc::invalid_argument, "a sweep needs a name");
+  if (meta.total_points < 0) return make_error(errc::invalid_argument, "total_points must be >= 0");
+  Transaction tx(d.db, d.tx);
+  if (auto s = tx.begin(); !s) return s.error();
+  std::int64_t id = 0;
+  {
+    auto& st = d.insert_sweep;
+    Statement::Use use(st);
+    st.bind(1, meta.name);
+    st.bind(2, now_utc());
+    st.bind(3, json_text(meta.plan));
+    st.bind(4, meta.software_version);
+    st.bind(5, json_text(meta.profiles));
+    st.bind(6, json_text(meta.bench_config));
+    st.bind(7, json_text(meta.calibration));
+    st.bind(8, meta.total_points);
+    const int rc = st.step();
+    if (rc != SQLITE_DONE) return d.fail(rc, "creating a sweep");
+    id = sqlite3_last_insert_rowid(d.db);
+  }
+  if (auto s = d.add_event_in_tx(id, EventKind::state, "created", nullptr); !s) return s.error();
+  if (auto s = tx.commit(); !s) return s.error();
+  return id;
+}
+
+Status Store::set_sweep_state(std::int64_t sweep_id, SweepState state, const std::optional<std::string>& error) {
+  auto& d = impl();
+  Transaction tx(d.db, d.tx);
+  if (auto s = tx.begin(); !s) return s;
+
+  SweepState from{};
+  std::optional<std::string> started_at;
+  std::int64_t total = 0, stored = 0;
+  {
+    auto& st = d.sweep_for_update;
+    Statement::Use use(st);
+    st.bind(1, sweep_id);
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+    if (rc != SQLITE_ROW) return d.fail(rc, "reading the sweep's state");
+    const auto f = parse_sweep_state(st.text(0));
+    if (!f) return make_error(errc::bad_record, "sweep " + std::to_string(sweep_id) + " has an unknown state");
+    from = *f;
+    started_at = st.opt_text(1);
+    total = st.integer(2);
+    stored = st.integer(3);
+  }
+  const std::string transition = std::string(name(from)) + " -> " + std::string(name(state));
+  if (from == SweepState::completed && state != SweepState::completed)
+    return make_error(errc::invalid_transition, transition + ": a completed sweep is final");
+  if (state == SweepState::created && from != SweepState::created)
+    return make_error(errc::invalid_transition, transition + ": a sweep cannot return to created");
+  if (state == SweepState::completed && stored < total)
+    return make_error(errc::invalid_transition, transition + ": only " + std::to_string(stored) + " of " +
+                                                    std::to_string(total) + " points are stored");
+
+  const std::string now = now_utc();
+  if (state == SweepState::running && !started_at) started_at = now;
+  {
+    auto& st = d.update_sweep_state;
+    Statement::Use use(st);
+    st.bind(1, name(state));
+    st.bind(2, started_at);
+    st.bind(3, finished(state) ? std::optional<std::string>(now) : std::nullopt);
+    st.bind(4, error);
+    st.bind(5, sweep_id);
+    const int rc = st.step();
+    if (rc != SQLITE_DONE) return d.fail(rc, "changing the sweep's state");
+  }
+  const std::string message = error ? transition + ": " + *error : transition;
+  if (auto s = d.add_event_in_tx(sweep_id, EventKind::state, message, nullptr); !s) return s;
+  return tx.commit();
+}
+
+Result<Sweep> Store::get_sweep(std::int64_t sweep_id) {
+  auto& d = impl();
+  auto& st = d.select_sweep;
+  Statement::Use use(st);
+  st.bind(1, sweep_id);
+  const int rc = st.step();
+  if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+  if (rc != SQLITE_ROW) return d.fail(rc, "reading a sweep");
+  return d.read_sweep(st);
+}
+
+Result<std::vector<Sweep>> Store::list_sweeps() {
+  auto& d = impl();
+  auto& st = d.select_sweeps;
+  Statement::Use use(st);
+  std::vector<Sweep> out;
+  for (;;) {
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return out;
+    if (rc != SQLITE_ROW) return d.fail(rc, "listing sweeps");
+    auto s = d.read_sweep(st);
+    if (!s) return s.error();
+    out.push_back(std::move(*s));
+  }
+}
+
+Status Store::insert_point(std::int64_t sweep_id, std::int64_t point_index, const bench::PointRecord& record) {
+  auto& d = impl();
+  const std::string which = "point " + std::to_string(point_index) + " of sweep " + std::to_string(sweep_id);
+  Transaction tx(d.db, d.tx);
+  if (auto s = tx.begin(); !s) return s;
+  {
+    auto& st = d.sweep_total;
+    Statement::Use use(st);
+    st.bind(1, sweep_id);
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+    if (rc != SQLITE_ROW) return d.fail(rc, "storing " + which);
+    const std::int64_t total = st.integer(0);
+    if (point_index < 0 || point_index >= total)
+      return make_error(errc::invalid_argument,
+                        which + ": the plan has indices 0 to " + std::to_string(total - 1));
+  }
+  {
+    auto& st = d.insert_point;
+    Statement::Use use(st);
+    st.bind(1, sweep_id);
+    st.bind(2, point_index);
+    bind_record(st, 3, record);
+    const int base = 3 + static_cast<int>(detail::kRecordColumns.size());
+    st.bind(base, record.truth ? std::optional<std::string>(truth_text(*record.truth)) : std::nullopt);
+    st.bind(base + 1, now_utc());
+    const int rc = st.step();
+    // The transaction rolls back on the way out; the stored point is untouched.
+    if (rc == SQLITE_CONSTRAINT_UNIQUE || rc == SQLITE_CONSTRAINT_PRIMARYKEY)
+      return make_error(errc::duplicate_point, which + " is already stored");
+    if (rc != SQLITE_DONE) return d.fail(rc, "storing " + which);
+  }
+  if (auto s = tx.commit(); !s) return Error{s.error().code, "storing " + which + ": " + s.error().message};
+  return {};
+}
+
+Result<std::vector<PointRow>> Store::points(std::int64_t sweep_id) {
+  auto& d = impl();
+  auto e = d.exists(sweep_id);
+  if (!e) return e.error();
+  if (!*e) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+  auto& st = d.select_points;
+  Statement::Use use(st);
+  st.bind(1, sweep_id);
+  std::vector<PointRow> out;
+  const int truth_col = 1 + static_cast<int>(detail::kRecordColumns.size());
+  for (;;) {
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return out;
+    if (rc != SQLITE_ROW) return d.fail(rc, "reading points");
+    PointRow row;
+    row.index = st.integer(0);
+    const auto where = [&] { return "point " + std::to_string(row.index) + " of sweep " + std::to_string(sweep_id); };
+    if (auto s = read_record(st, 1, row.record); !s) return make_error(errc::bad_record, where() + ": " + s.error().message);
+    if (!st.is_null(truth_col)) {
+      auto t = parse_truth(st.text(truth_col));
+      if (!t) return make_error(errc::bad_record, where() + ": " + t.error().message);
+      row.record.truth = *t;
+    }
+    out.push_back(std::move(row));
+  }
+}
+
+Result<std::vector<std::int64_t>> Store::missing_indices(std::int64_t sweep_id) {
+  auto& d = impl();
+  std::int64_t total = 0;
+  {
+    auto& st = d.sweep_total;
+    Statement::Use use(st);
+    st.bind(1, sweep_id);
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+    if (rc != SQLITE_ROW) return d.fail(rc, "reading the sweep's size");
+    total = st.integer(0);
+  }
+  // Stored indices come sorted and lie in 0 .. total-1 (insert_point enforces it): a merge walk.
+  auto& st = d.select_indices;
+  Statement::Use use(st);
+  st.bind(1, sweep_id);
+  std::vector<std::int64_t> missing;
+  std::int64_t next = 0;
+  for (;;) {
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) break;
+    if (rc != SQLITE_ROW) return d.fail(rc, "reading stored indices");
+    const std::int64_t stored = st.integer(0);
+    for (; next < stored && next < total; ++next) missing.push_back(next);
+    next = stored + 1;
+  }
+  for (; next < total; ++next) missing.push_back(next);
+  return missing;
+}
+
+Result<std::optional<std::int64_t>> Store::first_missing_index(std::int64_t sweep_id) {
+  auto m = missing_indices(sweep_id);
+  if (!m) return m.error();
+  if (m->empty()) return std::optional<std::int64_t>();
+  return std::optional<std::int64_t>(m->front());
+}
+
+Result<std::int64_t> Store::add_event(std::optional<std::int64_t> sweep_id, EventKind kind, std::string_view message) {
+  auto& d = impl();
+  Transaction tx(d.db, d.tx);
+  if (auto s = tx.begin(); !s) return s.error();
+  std::int64_t id = 0;
+  if (auto s = d.add_event_in_tx(sweep_id, kind, message, &id); !s) return s.error();
+  if (auto s = tx.commit(); !s) return s.error();
+  return id;
+}
+
+Result<std::vector<Event>> Store::events(std::optional<std::int64_t> sweep_id) {
+  auto& d = impl();
+  if (sweep_id) {
+    auto e = d.exists(*sweep_id);
+    if (!e) return e.error();
+    if (!*e) return make_error(errc::not_found, "no sweep " + std::to_string(*sweep_id));
+  }
+  auto& st = sweep_id ? d.select_events_of_sweep : d.select_events_all;
+  Statement::Use use(st);
+  if (sweep_id) st.bind(1, *sweep_id);
+  std::vector<Event> out;
+  for (;;) {
+    const int rc = st.step();
+    if (rc == SQLITE_DONE) return out;
+    if (rc != SQLITE_ROW) return d.fail(rc, "reading events");
+    Event e;
+    e.id = st.integer(0);
+    if (!st.is_null(1)) e.sweep_id = st.integer(1);
+    e.at = st.text(2);
+    const auto kind = parse_event_kind(st.text(3));
+    if (!kind) return make_error(errc::bad_record, "event " + std::to_string(e.id) + " has an unknown kind");
+    e.kind = *kind;
+    e.message = st.text(4);
+    out.push_back(std::move(e));
+  }
+}
+
+Status Store::integrity_check() {
+  auto& d = impl();
+  std::string findings;
+  for (const char* sql : {"PRAGMA integrity_check", "PRAGMA foreign_key_check"}) {
+    auto st = Statement::prepare(d.db, sql);
+    if (!st) return st.error();
+    for (;;) {
+      const int rc = st->step();
+      if (rc == SQLITE_DONE) break;
+      if (rc != SQLITE_ROW) return d.fail(rc, sql);
+      std::string row;
+      for (int c = 0; c < sqlite3_column_count(st->get()); ++c) {
+        if (c) row += " ";
+        row += st->is_null(c) ? "NULL" : st->text(c);
+      }
+      // integrity_check answers a single "ok" when all is well; foreign_key_check answers nothing.
+      if (row == "ok") continue;
+      findings += findings.empty() ? "" : "; ";
+      findings += row;
+    }
+  }
+  if (findings.empty()) return {};
+  return make_error(errc::corrupt, d.path.string() + ": " + findings);
+}
+
+Result<std::string> Store::pragma(std::string_view pragma_name) {
+  auto& d = impl();
+  if (pragma_name.empty() || pragma_name.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") != std::string_view::npos)
+    return make_error(errc::invalid_argument, "pragma name must be [a-z_]+");
+  const std::string sql = "PRAGMA " + std::string(pragma_name);
+  auto st = Statement::prepare(d.db, sql);
+  if (!st) return st.error();
+  const int rc = st->step();
+  if (rc == SQLITE_DONE) return std::string();
+  if (rc != SQLITE_ROW) return d.fail(rc, sql);
+  return st->text(0);
+}
+
+}  // namespace synbench::db

@@ -1,0 +1,96 @@
+// synbench's SQLite store: sweeps with their metadata, one row per measured point, events.
+//
+// Durability: WAL with synchronous=FULL, and one transaction per point, so insert_point returns
+// only once its point is on disk; a crash (process or power) loses at most the point in flight,
+// and a sweep resumes at first_missing_index(). UNIQUE(sweep_id, point_index) makes a resumed
+// sweep unable to store a point twice.
+//
+// Threads: a Store is one SQLite connection with its prepared statements and is used from one
+// thread at a time (the one that owns it); it is movable, not copyable. Other processes or
+// connections may read the same file concurrently (WAL); writers wait up to busy_timeout.
+//
+// Errors: every call returns Status or Result<T>; nothing throws except on programmer errors
+// (reading the value of a failed Result, or calling anything on a moved-from Store).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/point_record.hpp"
+#include "db/error.hpp"
+#include "db/types.hpp"
+
+namespace synbench::db {
+
+struct StoreOptions {
+  int busy_timeout_ms = 5000;  // how long a write waits for another connection's lock
+};
+
+class Store {
+ public:
+  // Creates the file if needed, sets WAL, synchronous=FULL, foreign_keys and busy_timeout, and
+  // applies pending migrations. Refuses a database newer than this code (errc::schema_too_new)
+  // or another application's database (errc::not_synbench).
+  static Result<Store> open(const std::filesystem::path& path, const StoreOptions& options = {});
+
+  Store(Store&&) noexcept;
+  Store& operator=(Store&&) noexcept;
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+  ~Store();
+
+  const std::filesystem::path& path() const;
+
+  // --- sweeps ---
+  // A new sweep in state `created` (and its `state` event), in one transaction.
+  Result<std::int64_t> create_sweep(const SweepMeta& meta);
+  // Changes the state, records a `state` event ("running -> paused: <error>") in the same
+  // transaction, stamps started_at (first time running) and finished_at (completed, aborted,
+  // faulted; cleared when resumed), and keeps `error` as last_error if given. Refuses
+  // (errc::invalid_transition) leaving `completed`, returning to `created`, and `completed` while
+  // points are missing.
+  Status set_sweep_state(std::int64_t sweep_id, SweepState state,
+                         const std::optional<std::string>& error = std::nullopt);
+  Result<Sweep> get_sweep(std::int64_t sweep_id);
+  Result<std::vector<Sweep>> list_sweeps();  // by id
+
+  // --- points ---
+  // Stores one point in its own transaction, committed (fsynced) before returning.
+  // errc::duplicate_point if (sweep_id, point_index) is already stored (nothing changes),
+  // errc::not_found for an unknown sweep, errc::invalid_argument for an index outside
+  // 0 .. total_points-1.
+  Status insert_point(std::int64_t sweep_id, std::int64_t point_index, const bench::PointRecord& record);
+  // All stored points of a sweep by index. Every field round-trips exactly, nulls and truth
+  // included; the one loss is SQLite's: a NaN in an optional field reads back as null.
+  Result<std::vector<PointRow>> points(std::int64_t sweep_id);
+  // Plan indices 0 .. total_points-1 without a stored point, ascending.
+  Result<std::vector<std::int64_t>> missing_indices(std::int64_t sweep_id);
+  // Where a resumed sweep starts: the lowest missing index, or nullopt if the sweep is complete.
+  Result<std::optional<std::int64_t>> first_missing_index(std::int64_t sweep_id);
+
+  // --- events ---
+  // sweep_id nullopt for a bench-wide event. Returns the event id.
+  Result<std::int64_t> add_event(std::optional<std::int64_t> sweep_id, EventKind kind,
+                                 std::string_view message);
+  // One sweep's events (errc::not_found for an unknown sweep), or all events, bench-wide
+  // included, for nullopt; oldest first.
+  Result<std::vector<Event>> events(std::optional<std::int64_t> sweep_id = std::nullopt);
+
+  // --- maintenance ---
+  // PRAGMA integrity_check and foreign_key_check; errc::corrupt with their findings if not ok.
+  Status integrity_check();
+  // The value of a pragma on this connection, as text (e.g. "wal", "2"); name is [a-z_]+.
+  Result<std::string> pragma(std::string_view name);
+
+ private:
+  struct Impl;
+  explicit Store(std::unique_ptr<Impl> impl);
+  Impl& impl() const;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace synbench::db

@@ -1,0 +1,66 @@
+// What the store keeps besides the records themselves: sweeps with their metadata and state,
+// stored points with their index, and events (faults, state changes, log lines).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "bench/point_record.hpp"
+#include "synbench/version.hpp"
+
+namespace synbench::db {
+
+// created -> running <-> paused -> completed | aborted | faulted; a faulted or aborted sweep may
+// be resumed (-> running); completed is final. Stored as these names.
+enum class SweepState { created, running, paused, completed, aborted, faulted };
+
+std::string_view name(SweepState s) noexcept;
+std::optional<SweepState> parse_sweep_state(std::string_view s) noexcept;
+
+// Everything needed to know later how a sweep's points were obtained. JSON members that are
+// null are stored as SQL NULL.
+struct SweepMeta {
+  std::string name;                           // for people; need not be unique
+  nlohmann::ordered_json plan;                // the sweep plan as run (expanded or as given)
+  std::string software_version = kVersion;    // synbench's version
+  nlohmann::ordered_json profiles;            // the device profiles in use
+  nlohmann::ordered_json bench_config;        // the bench configuration in use
+  nlohmann::ordered_json calibration;         // meter/sensor calibration, if any
+  std::int64_t total_points = 0;              // points in the plan: indices 0 .. total_points-1
+};
+
+struct Sweep {
+  std::int64_t id = 0;
+  SweepMeta meta;
+  SweepState state = SweepState::created;
+  std::string created_at;                   // UTC, ISO 8601 with milliseconds ("...T12:00:00.000Z")
+  std::optional<std::string> started_at;    // first time the sweep ran
+  std::optional<std::string> finished_at;   // when it last became completed, aborted or faulted
+  std::optional<std::string> last_error;    // the last error given with a state change
+  std::int64_t points_stored = 0;
+};
+
+// One stored point: its index in the sweep's plan and the record.
+struct PointRow {
+  std::int64_t index = 0;
+  bench::PointRecord record;
+};
+
+enum class EventKind { fault, state, log };
+
+std::string_view name(EventKind k) noexcept;
+std::optional<EventKind> parse_event_kind(std::string_view s) noexcept;
+
+struct Event {
+  std::int64_t id = 0;
+  std::optional<std::int64_t> sweep_id;  // null for bench-wide events
+  std::string at;                        // UTC, ISO 8601 with milliseconds
+  EventKind kind = EventKind::log;
+  std::string message;
+};
+
+}  // namespace synbench::db

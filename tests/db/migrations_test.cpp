@@ -1,0 +1,200 @@
+// Opening a store: migrations from an empty file, reopening, refusing newer or foreign files,
+// one transaction per step, and the connection's pragmas.
+#include "db/migrations.hpp"
+
+#include <sqlite3.h>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "bench/point_record.hpp"
+#include "db/point_columns.hpp"
+#include "db/store.hpp"
+#include "tests/db/sample_records.hpp"
+
+namespace synbench::db {
+namespace {
+
+using testing::TempDir;
+
+// A plain SQLite connection, to look at the file without the Store.
+class Raw {
+ public:
+  explicit Raw(const std::filesystem::path& p) {
+    if (sqlite3_open(p.c_str(), &db_) != SQLITE_OK) throw std::runtime_error("sqlite3_open");
+  }
+  ~Raw() { sqlite3_close(db_); }
+  Raw(const Raw&) = delete;
+  Raw& operator=(const Raw&) = delete;
+  sqlite3* get() const { return db_; }
+  void exec(const std::string& sql) {
+    char* err = nullptr;
+    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+      std::string m = err ? err : "?";
+      sqlite3_free(err);
+      throw std::runtime_error(m);
+    }
+  }
+  std::vector<std::string> column(const std::string& sql, int col = 0) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &st, nullptr) != SQLITE_OK) throw std::runtime_error(sqlite3_errmsg(db_));
+    std::vector<std::string> out;
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      const auto* t = sqlite3_column_text(st, col);
+      out.emplace_back(t ? reinterpret_cast<const char*>(t) : "NULL");
+    }
+    sqlite3_finalize(st);
+    return out;
+  }
+  std::string one(const std::string& sql) {
+    auto v = column(sql);
+    return v.empty() ? "" : v.front();
+  }
+
+ private:
+  sqlite3* db_ = nullptr;
+};
+
+TEST(Migrations, AreNumberedFromOneInOrder) {
+  const auto steps = migrations();
+  ASSERT_FALSE(steps.empty());
+  for (std::size_t i = 0; i < steps.size(); ++i) EXPECT_EQ(steps[i].version, static_cast<int>(i) + 1);
+  EXPECT_EQ(schema_version(), steps.back().version);
+}
+
+TEST(Migrations, CreateTheSchemaInAnEmptyFile) {
+  TempDir dir;
+  const auto path = dir / "new.db";
+  {
+    auto store = Store::open(path);
+    ASSERT_TRUE(store) << store.error().message;
+    EXPECT_EQ(store->pragma("user_version").value(), std::to_string(schema_version()));
+    EXPECT_EQ(store->pragma("application_id").value(), std::to_string(kApplicationId));
+  }
+  Raw raw(path);
+  EXPECT_EQ(raw.column("SELECT name FROM sqlite_schema WHERE type = 'table' ORDER BY name"),
+            (std::vector<std::string>{"events", "points", "sweeps"}));
+}
+
+TEST(Migrations, ReopeningKeepsDataAndAppliesNothing) {
+  TempDir dir;
+  const auto path = dir / "reopen.db";
+  std::int64_t id = 0;
+  {
+    auto store = Store::open(path);
+    ASSERT_TRUE(store) << store.error().message;
+    SweepMeta meta;
+    meta.name = "first";
+    meta.total_points = 2;
+    id = store->create_sweep(meta).value();
+    ASSERT_TRUE(store->insert_point(id, 1, testing::sample_record(1)));
+  }
+  std::string schema_before = Raw(path).one("SELECT group_concat(sql, ';') FROM sqlite_schema");
+  auto store = Store::open(path);
+  ASSERT_TRUE(store) << store.error().message;
+  EXPECT_EQ(store->get_sweep(id).value().meta.name, "first");
+  EXPECT_EQ(store->points(id).value().size(), 1u);
+  EXPECT_EQ(store->pragma("user_version").value(), std::to_string(schema_version()));
+  EXPECT_EQ(Raw(path).one("SELECT group_concat(sql, ';') FROM sqlite_schema"), schema_before);
+}
+
+TEST(Migrations, RefuseADatabaseNewerThanTheCode) {
+  TempDir dir;
+  const auto path = dir / "newer.db";
+  { ASSERT_TRUE(Store::open(path)); }
+  Raw(path).exec("PRAGMA user_version = " + std::to_string(schema_version() + 1));
+  auto store = Store::open(path);
+  ASSERT_FALSE(store);
+  EXPECT_EQ(store.code(), errc::schema_too_new);
+  EXPECT_NE(store.error().message.find("newer"), std::string::npos) << store.error().message;
+  EXPECT_NE(store.error().message.find(std::to_string(schema_version() + 1)), std::string::npos);
+  // Nothing was touched.
+  EXPECT_EQ(Raw(path).one("PRAGMA user_version"), std::to_string(schema_version() + 1));
+}
+
+TEST(Migrations, RefuseAnotherApplicationsDatabase) {
+  TempDir dir;
+  const auto path = dir / "foreign.db";
+  Raw(path).exec("CREATE TABLE notes (text TEXT)");
+  auto store = Store::open(path);
+  ASSERT_FALSE(store);
+  EXPECT_EQ(store.code(), errc::not_synbench);
+  EXPECT_EQ(Raw(path).column("SELECT name FROM sqlite_schema"), std::vector<std::string>{"notes"});
+}
+
+TEST(Migrations, RefuseAFileThatIsNotADatabase) {
+  TempDir dir;
+  const auto path = dir / "text.db";
+  std::ofstream(path) << std::string(4096, 'x');
+  auto store = Store::open(path);
+  ASSERT_FALSE(store);
+  EXPECT_EQ(store.code(), errc::corrupt) << store.error().message;
+}
+
+TEST(Migrations, ReportAnUnopenableFile) {
+  TempDir dir;
+  auto store = Store::open(dir / "no-such-dir" / "x.db");
+  ASSERT_FALSE(store);
+  EXPECT_EQ(store.code(), errc::io) << store.error().message;
+  EXPECT_NE(store.error().message.find("no-such-dir"), std::string::npos);
+  EXPECT_EQ(Store::open("").code(), errc::invalid_argument);
+}
+
+TEST(Migrations, EachStepIsOneTransaction) {
+  // A step that fails halfway leaves the database at the previous version, without the half.
+  TempDir dir;
+  Raw raw(dir / "steps.db");
+  const Migration steps[] = {
+      {1, "one table", "CREATE TABLE a (x INTEGER);"},
+      {2, "fails after its first statement", "CREATE TABLE b (x INTEGER); INSERT INTO nowhere VALUES (1);"},
+  };
+  const auto s = detail::migrate(raw.get(), steps);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message.find("version 2"), std::string::npos) << s.error().message;
+  EXPECT_EQ(raw.one("PRAGMA user_version"), "1");
+  EXPECT_EQ(raw.column("SELECT name FROM sqlite_schema ORDER BY name"), std::vector<std::string>{"a"});
+  // With the step fixed, migration continues from version 1.
+  const Migration fixed[] = {steps[0], {2, "fixed", "CREATE TABLE b (x INTEGER);"}};
+  ASSERT_TRUE(detail::migrate(raw.get(), fixed));
+  EXPECT_EQ(raw.one("PRAGMA user_version"), "2");
+  EXPECT_EQ(raw.column("SELECT name FROM sqlite_schema ORDER BY name"), (std::vector<std::string>{"a", "b"}));
+}
+
+TEST(Pragmas, WalFullSynchronousForeignKeysAndBusyTimeout) {
+  TempDir dir;
+  const auto path = dir / "pragmas.db";
+  StoreOptions options;
+  options.busy_timeout_ms = 1234;
+  auto store = Store::open(path, options);
+  ASSERT_TRUE(store) << store.error().message;
+  EXPECT_EQ(store->pragma("journal_mode").value(), "wal");
+  EXPECT_EQ(store->pragma("synchronous").value(), "2");  // FULL
+  EXPECT_EQ(store->pragma("foreign_keys").value(), "1");
+  EXPECT_EQ(store->pragma("busy_timeout").value(), "1234");
+  // WAL is a property of the file: another connection sees it too.
+  EXPECT_EQ(Raw(path).one("PRAGMA journal_mode"), "wal");
+  EXPECT_EQ(store->pragma("not a pragma").code(), errc::invalid_argument);
+}
+
+TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
+  // experiment.md Sec. 2.5 through bench::to_json, the store's column table and the table itself.
+  std::vector<std::string> record_fields;
+  const auto record = bench::to_json(bench::PointRecord{});
+  for (const auto& [key, value] : record.items())
+    if (key != "truth") record_fields.push_back(key);
+  std::vector<std::string> store_columns;
+  for (const auto& c : detail::kRecordColumns) store_columns.emplace_back(c.name);
+  EXPECT_EQ(store_columns, record_fields);
+
+  TempDir dir;
+  const auto path = dir / "schema.db";
+  { ASSERT_TRUE(Store::open(path)); }
+  std::vector<std::string> expected{"id", "sweep_id", "point_index"};
+  expected.insert(expected.end(), record_fields.begin(), record_fields.end());
+  expected.insert(expected.end(), {"truth_json", "measured_at"});
+  EXPECT_EQ(Raw(path).column("SELECT name FROM pragma_table_info('points') ORDER BY cid"), expected);
+}
+
+}  // namespace
+}  // namespace synbench::db

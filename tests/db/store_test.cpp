@@ -1,0 +1,287 @@
+// The store on real SQLite files: sweeps and their states, every record field through the
+// database, duplicates, missing indices, events, integrity.
+#include "db/store.hpp"
+
+#include <sqlite3.h>
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <regex>
+
+#include "tests/db/sample_records.hpp"
+
+namespace synbench::db {
+namespace {
+
+using testing::exact_text;
+using testing::sample_record;
+using testing::TempDir;
+
+class StoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto s = Store::open(dir_ / "store.db");
+    ASSERT_TRUE(s) << s.error().message;
+    store_.emplace(std::move(*s));
+  }
+
+  std::int64_t make_sweep(std::int64_t total, const std::string& name = "sweep") {
+    SweepMeta meta;
+    meta.name = name;
+    meta.total_points = total;
+    auto id = store_->create_sweep(meta);
+    EXPECT_TRUE(id) << id.error().message;
+    return id ? *id : -1;
+  }
+
+  TempDir dir_;
+  std::optional<Store> store_;
+};
+
+TEST_F(StoreTest, CreatesASweepWithItsMetadata) {
+  SweepMeta meta;
+  meta.name = "thesis grid, encoder";
+  meta.plan = nlohmann::ordered_json::parse(R"({"speeds_rpm":[500,1000],"loads_Nm":[0,1.5],"z":1,"a":2})");
+  meta.profiles = {{"synrm", {{"unit", 1}}}, {"pmsm", {{"unit", 2}}}};
+  meta.bench_config = {{"transport", "twin"}};
+  meta.total_points = 4;  // calibration left null
+  const auto id = store_->create_sweep(meta);
+  ASSERT_TRUE(id) << id.error().message;
+
+  const auto s = store_->get_sweep(*id);
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->id, *id);
+  EXPECT_EQ(s->meta.name, meta.name);
+  EXPECT_EQ(s->meta.plan.dump(), meta.plan.dump()) << "key order kept";
+  EXPECT_EQ(s->meta.profiles, meta.profiles);
+  EXPECT_EQ(s->meta.bench_config, meta.bench_config);
+  EXPECT_TRUE(s->meta.calibration.is_null());
+  EXPECT_EQ(s->meta.software_version, std::string(kVersion));
+  EXPECT_EQ(s->meta.total_points, 4);
+  EXPECT_EQ(s->state, SweepState::created);
+  EXPECT_TRUE(std::regex_match(s->created_at, std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z)")))
+      << s->created_at;
+  EXPECT_FALSE(s->started_at);
+  EXPECT_FALSE(s->finished_at);
+  EXPECT_FALSE(s->last_error);
+  EXPECT_EQ(s->points_stored, 0);
+}
+
+TEST_F(StoreTest, RefusesBadSweepMetadata) {
+  SweepMeta meta;
+  EXPECT_EQ(store_->create_sweep(meta).code(), errc::invalid_argument) << "no name";
+  meta.name = "x";
+  meta.total_points = -1;
+  EXPECT_EQ(store_->create_sweep(meta).code(), errc::invalid_argument);
+  EXPECT_TRUE(store_->list_sweeps().value().empty());
+}
+
+TEST_F(StoreTest, ListsSweepsById) {
+  const auto a = make_sweep(1, "a");
+  const auto b = make_sweep(2, "b");
+  const auto list = store_->list_sweeps();
+  ASSERT_TRUE(list);
+  ASSERT_EQ(list->size(), 2u);
+  EXPECT_EQ((*list)[0].id, a);
+  EXPECT_EQ((*list)[0].meta.name, "a");
+  EXPECT_EQ((*list)[1].id, b);
+  EXPECT_EQ((*list)[1].meta.total_points, 2);
+}
+
+TEST_F(StoreTest, StateChangesStampTimesAndRecordEvents) {
+  const auto id = make_sweep(2);
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
+  const auto started = store_->get_sweep(id).value().started_at;
+  ASSERT_TRUE(started);
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::paused));
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
+  EXPECT_EQ(store_->get_sweep(id).value().started_at, started) << "first start kept";
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::faulted, std::string("overcurrent at point 1")));
+  auto s = store_->get_sweep(id).value();
+  EXPECT_EQ(s.state, SweepState::faulted);
+  EXPECT_TRUE(s.finished_at);
+  EXPECT_EQ(s.last_error, "overcurrent at point 1");
+  // Resumed after the fault: unfinished again, the error kept for the record.
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
+  s = store_->get_sweep(id).value();
+  EXPECT_FALSE(s.finished_at);
+  EXPECT_EQ(s.last_error, "overcurrent at point 1");
+
+  const auto ev = store_->events(id).value();
+  std::vector<std::string> messages;
+  for (const auto& e : ev) {
+    EXPECT_EQ(e.kind, EventKind::state);
+    EXPECT_EQ(e.sweep_id, id);
+    messages.push_back(e.message);
+  }
+  EXPECT_EQ(messages, (std::vector<std::string>{"created", "created -> running", "running -> paused",
+                                                "paused -> running",
+                                                "running -> faulted: overcurrent at point 1",
+                                                "faulted -> running"}));
+}
+
+TEST_F(StoreTest, CompletedNeedsEveryPointAndIsFinal) {
+  const auto id = make_sweep(2);
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
+  ASSERT_TRUE(store_->insert_point(id, 0, sample_record(0)));
+  const auto early = store_->set_sweep_state(id, SweepState::completed);
+  EXPECT_EQ(early.code(), errc::invalid_transition);
+  EXPECT_NE(early.error().message.find("1 of 2"), std::string::npos) << early.error().message;
+  EXPECT_EQ(store_->get_sweep(id).value().state, SweepState::running) << "unchanged";
+
+  ASSERT_TRUE(store_->insert_point(id, 1, sample_record(1)));
+  ASSERT_TRUE(store_->set_sweep_state(id, SweepState::completed));
+  const auto s = store_->get_sweep(id).value();
+  EXPECT_EQ(s.state, SweepState::completed);
+  EXPECT_TRUE(s.finished_at);
+  EXPECT_EQ(s.points_stored, 2);
+  EXPECT_EQ(store_->set_sweep_state(id, SweepState::running).code(), errc::invalid_transition);
+  EXPECT_EQ(store_->set_sweep_state(id, SweepState::created).code(), errc::invalid_transition);
+}
+
+TEST_F(StoreTest, UnknownSweepIsNotFound) {
+  EXPECT_EQ(store_->get_sweep(42).code(), errc::not_found);
+  EXPECT_EQ(store_->set_sweep_state(42, SweepState::running).code(), errc::not_found);
+  EXPECT_EQ(store_->insert_point(42, 0, sample_record(0)).code(), errc::not_found);
+  EXPECT_EQ(store_->points(42).code(), errc::not_found);
+  EXPECT_EQ(store_->missing_indices(42).code(), errc::not_found);
+  EXPECT_EQ(store_->add_event(42, EventKind::log, "x").code(), errc::not_found);
+  EXPECT_EQ(store_->events(42).code(), errc::not_found);
+}
+
+TEST_F(StoreTest, EveryFieldRoundTripsExactly) {
+  constexpr std::int64_t kTotal = 60;  // covers every estimator, pwm, null pattern, truth, fault
+  const auto id = make_sweep(kTotal);
+  for (std::int64_t i = kTotal - 1; i >= 0; --i)  // stored out of order, read back by index
+    ASSERT_TRUE(store_->insert_point(id, i, sample_record(i))) << i;
+  const auto rows = store_->points(id);
+  ASSERT_TRUE(rows) << rows.error().message;
+  ASSERT_EQ(rows->size(), static_cast<std::size_t>(kTotal));
+  for (std::int64_t i = 0; i < kTotal; ++i) {
+    const auto& row = (*rows)[static_cast<std::size_t>(i)];
+    EXPECT_EQ(row.index, i);
+    EXPECT_EQ(exact_text(row.record), exact_text(sample_record(i))) << "point " << i;
+  }
+  // The samples do exercise what could be lost.
+  const auto& r0 = (*rows)[0].record;
+  EXPECT_TRUE(std::signbit(r0.angle_deg));
+  EXPECT_FALSE(r0.truth);
+  EXPECT_FALSE(r0.pos_err_mean_deg);
+  EXPECT_EQ(std::bit_cast<std::uint64_t>((*rows)[1].record.truth->pmech_W), std::bit_cast<std::uint64_t>(1.5e-310));
+  EXPECT_EQ((*rows)[8].record.fault, "link_loss, \"quoted\"");
+  EXPECT_EQ((*rows)[13].record.fault, "overcurrent");
+}
+
+TEST_F(StoreTest, NanInARequiredFieldComesBackAsNan) {
+  // SQLite cannot store NaN; the store writes NULL, which a required field reads as NaN.
+  const auto id = make_sweep(1);
+  auto r = sample_record(2);
+  r.efficiency = std::numeric_limits<double>::quiet_NaN();
+  r.ld_est_H = std::numeric_limits<double>::quiet_NaN();  // optional: reads back as null
+  r.speed_rpm = std::numeric_limits<double>::infinity();
+  ASSERT_TRUE(store_->insert_point(id, 0, r));
+  const auto back = store_->points(id).value().at(0).record;
+  EXPECT_TRUE(std::isnan(back.efficiency));
+  EXPECT_FALSE(back.ld_est_H);
+  EXPECT_EQ(back.speed_rpm, std::numeric_limits<double>::infinity());
+}
+
+TEST_F(StoreTest, DuplicatePointIsRejectedAndChangesNothing) {
+  const auto id = make_sweep(5);
+  ASSERT_TRUE(store_->insert_point(id, 3, sample_record(3)));
+  const auto before = store_->points(id).value();
+  const auto events_before = store_->events().value().size();
+
+  const auto dup = store_->insert_point(id, 3, sample_record(4));
+  ASSERT_FALSE(dup);
+  EXPECT_EQ(dup.code(), errc::duplicate_point);
+  EXPECT_NE(dup.error().message.find("point 3"), std::string::npos) << dup.error().message;
+
+  const auto after = store_->points(id).value();
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(exact_text(after[0].record), exact_text(before[0].record));
+  EXPECT_EQ(store_->events().value().size(), events_before);
+  // The store is usable afterwards (no transaction left open).
+  EXPECT_TRUE(store_->insert_point(id, 4, sample_record(4)));
+}
+
+TEST_F(StoreTest, IndexOutsideThePlanIsRejected) {
+  const auto id = make_sweep(3);
+  EXPECT_EQ(store_->insert_point(id, -1, sample_record(0)).code(), errc::invalid_argument);
+  EXPECT_EQ(store_->insert_point(id, 3, sample_record(0)).code(), errc::invalid_argument);
+  EXPECT_TRUE(store_->points(id).value().empty());
+}
+
+TEST_F(StoreTest, MissingIndicesAndWhereToResume) {
+  const auto id = make_sweep(10);
+  EXPECT_EQ(store_->first_missing_index(id).value(), 0);
+  for (const std::int64_t i : {0, 1, 2, 5, 9}) ASSERT_TRUE(store_->insert_point(id, i, sample_record(i)));
+  EXPECT_EQ(store_->missing_indices(id).value(), (std::vector<std::int64_t>{3, 4, 6, 7, 8}));
+  EXPECT_EQ(store_->first_missing_index(id).value(), 3);
+  for (const std::int64_t i : {3, 4, 6, 7, 8}) ASSERT_TRUE(store_->insert_point(id, i, sample_record(i)));
+  EXPECT_TRUE(store_->missing_indices(id).value().empty());
+  EXPECT_EQ(store_->first_missing_index(id).value(), std::nullopt);
+
+  const auto empty = make_sweep(0, "empty");
+  EXPECT_TRUE(store_->missing_indices(empty).value().empty());
+}
+
+TEST_F(StoreTest, EventsPerSweepAndBenchWide) {
+  const auto a = make_sweep(1, "a");
+  const auto b = make_sweep(1, "b");
+  const auto e1 = store_->add_event(a, EventKind::fault, "overcurrent");
+  ASSERT_TRUE(e1) << e1.error().message;
+  ASSERT_TRUE(store_->add_event(std::nullopt, EventKind::log, "E-stop tested"));
+  ASSERT_TRUE(store_->add_event(b, EventKind::log, "note on b"));
+
+  const auto of_a = store_->events(a).value();
+  ASSERT_EQ(of_a.size(), 2u);  // "created", then the fault
+  EXPECT_EQ(of_a[1].id, *e1);
+  EXPECT_EQ(of_a[1].kind, EventKind::fault);
+  EXPECT_EQ(of_a[1].message, "overcurrent");
+  EXPECT_FALSE(of_a[1].at.empty());
+
+  const auto all = store_->events().value();
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_EQ(all[3].sweep_id, std::nullopt);
+  EXPECT_EQ(all[3].kind, EventKind::log);
+  for (std::size_t i = 1; i < all.size(); ++i) EXPECT_LT(all[i - 1].id, all[i].id);
+}
+
+TEST_F(StoreTest, ACommittedPointIsVisibleToAnotherConnectionAtOnce) {
+  // insert_point's transaction is over when it returns: a second connection (as a reader process
+  // would) sees the point without the store closing or checkpointing.
+  const auto id = make_sweep(2);
+  ASSERT_TRUE(store_->insert_point(id, 1, sample_record(1)));
+  sqlite3* other = nullptr;
+  ASSERT_EQ(sqlite3_open_v2(store_->path().c_str(), &other, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+  sqlite3_stmt* st = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(other, "SELECT count(*), max(point_index) FROM points", -1, &st, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(st, 0), 1);
+  EXPECT_EQ(sqlite3_column_int(st, 1), 1);
+  sqlite3_finalize(st);
+  sqlite3_close(other);
+}
+
+TEST_F(StoreTest, IntegrityCheckPassesOnAFreshAndAUsedDatabase) {
+  EXPECT_TRUE(store_->integrity_check());
+  const auto id = make_sweep(20);
+  for (std::int64_t i = 0; i < 20; ++i) ASSERT_TRUE(store_->insert_point(id, i, sample_record(i)));
+  const auto s = store_->integrity_check();
+  EXPECT_TRUE(s) << (s ? "" : s.error().message);
+}
+
+TEST_F(StoreTest, ProgrammerErrorsThrow) {
+  Result<std::int64_t> failed = make_error(errc::not_found, "x");
+  EXPECT_THROW(static_cast<void>(failed.value()), std::logic_error);
+  Store moved = std::move(*store_);
+  EXPECT_THROW(static_cast<void>(store_->list_sweeps()), std::logic_error);
+  EXPECT_TRUE(moved.list_sweeps());
+}
+
+}  // namespace
+}  // namespace synbench::db
