@@ -360,7 +360,8 @@ Result<std::int64_t> Store::create_sweep(const SweepMeta& meta) {
   return id;
 }
 
-Status Store::set_sweep_state(std::int64_t sweep_id, SweepState state, const std::optional<std::string>& error) {
+Status Store::set_sweep_state(std::int64_t sweep_id, SweepState state, const std::optional<std::string>& error,
+                              bool sparse_plan) {
   auto& d = impl();
   Transaction tx(d.db, d.tx);
   if (auto s = tx.begin(); !s) return s;
@@ -387,7 +388,7 @@ Status Store::set_sweep_state(std::int64_t sweep_id, SweepState state, const std
     return make_error(errc::invalid_transition, transition + ": a completed sweep is final");
   if (state == SweepState::created && from != SweepState::created)
     return make_error(errc::invalid_transition, transition + ": a sweep cannot return to created");
-  if (state == SweepState::completed && stored < total)
+  if (state == SweepState::completed && stored < total && !sparse_plan)
     return make_error(errc::invalid_transition, transition + ": only " + std::to_string(stored) + " of " +
                                                     std::to_string(total) + " points are stored");
 

@@ -53,8 +53,11 @@ class Store {
   // faulted; cleared when resumed), and keeps `error` as last_error if given. Refuses
   // (errc::invalid_transition) leaving `completed`, returning to `created`, and `completed` while
   // points are missing.
+  // `sparse_plan`: the plan does not need every index below total_points (an adaptive search
+  // stops when it has found its optima), so `completed` does not wait for the gaps.
   Status set_sweep_state(std::int64_t sweep_id, SweepState state,
-                         const std::optional<std::string>& error = std::nullopt);
+                         const std::optional<std::string>& error = std::nullopt,
+                         bool sparse_plan = false);
   Result<Sweep> get_sweep(std::int64_t sweep_id);
   Result<std::vector<Sweep>> list_sweeps();  // by id
 

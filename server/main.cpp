@@ -15,6 +15,7 @@ built-in twin.
 
 commands:
   point     measure one operating point on the in-process twin
+  sweep     run a sweep plan on the twin, stored in SQLite, resumable
   config    print or check the twin's configuration
 
   synbench <command> --help    options of a command
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   args.erase(args.begin());
   if (command == "point") return synbench::cli::point_command(args);
   if (command == "config") return synbench::cli::config_command(args);
+  if (command == "sweep") return synbench::cli::sweep_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

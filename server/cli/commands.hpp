@@ -9,8 +9,10 @@ namespace synbench::cli {
 
 int point_command(const std::vector<std::string>& args);
 int config_command(const std::vector<std::string>& args);
+int sweep_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
+extern const char* const kSweepHelp;
 
 }  // namespace synbench::cli

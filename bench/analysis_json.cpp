@@ -1,0 +1,248 @@
+// JSON form of an analysis (docs/analysis.md): every section an object with a description, the
+// thesis figure it reproduces and its entries; units in the key names; configurations as
+// "estimator" and "pwm" fields as in the point record.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "bench/analysis.hpp"
+
+namespace synbench::bench {
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+// A JSON document must not carry NaN or infinities (nlohmann writes them as null anyway; this
+// makes it explicit and keeps the C++ side honest).
+ojson number(double v) { return std::isfinite(v) ? ojson(v) : ojson(nullptr); }
+
+void put_configuration(ojson& j, const Configuration& c) {
+  j["estimator"] = std::string(drivers::name(c.estimator));
+  j["pwm"] = std::string(drivers::name(c.pwm));
+}
+
+ojson configuration(const Configuration& c) {
+  ojson j = ojson::object();
+  put_configuration(j, c);
+  return j;
+}
+
+ojson optimum(const CurveOptimum& o) {
+  ojson j = ojson::object();
+  j["angle_deg"] = number(o.angle_deg);
+  j["im_A"] = number(o.im_A);
+  j["pdcm_W"] = number(o.pdcm_W);
+  j["pm_W"] = number(o.pm_W);
+  j["efficiency"] = o.pdcm_W > 0 ? number(o.efficiency) : ojson(nullptr);
+  j["refined"] = o.refined;
+  j["at_edge"] = o.at_edge;
+  return j;
+}
+
+ojson delta(const TrajectoryDelta& d) {
+  ojson j = ojson::object();
+  j["delta_angle_deg"] = number(d.delta_angle_deg);
+  j["delta_im_A"] = number(d.delta_im_A);
+  j["delta_pdcm_W"] = number(d.delta_pdcm_W);
+  return j;
+}
+
+ojson section(const char* description, const char* figures) {
+  ojson j = ojson::object();
+  j["description"] = description;
+  j["thesis_figures"] = figures ? ojson(figures) : ojson(nullptr);
+  return j;
+}
+
+}  // namespace
+
+ojson to_json(const Analysis& a) {
+  ojson j = ojson::object();
+  j["schema"] = "synbench.analysis/1";
+
+  const auto& o = a.options;
+  ojson opt = ojson::object();
+  opt["reference"] = configuration(o.reference);
+  opt["exclude_unstable"] = o.exclude_unstable;
+  opt["exclude_faulted"] = o.exclude_faulted;
+  opt["exclude_voltage_limited"] = o.exclude_voltage_limited;
+  opt["bin_width"] = {{"pos_err_mean_deg", o.pos_err_bin_deg},
+                      {"ld_err_pct", o.ld_err_bin_pct},
+                      {"lq_err_pct", o.lq_err_bin_pct},
+                      {"rs_err_pct", o.rs_err_bin_pct}};
+  j["options"] = opt;
+
+  ojson pts = section("Records analysed; flagged ones are left out of every result below.", nullptr);
+  pts["records"] = a.records;
+  pts["used"] = a.used;
+  ojson ex = ojson::array();
+  for (const auto& e : a.excluded) {
+    ojson x = ojson::object();
+    x["record"] = e.record;
+    put_configuration(x, e.configuration);
+    x["speed_rpm"] = e.speed_rpm;
+    x["load_Nm"] = e.load_Nm;
+    x["angle_deg"] = e.angle_deg;
+    x["reasons"] = e.reasons;
+    ex.push_back(x);
+  }
+  pts["excluded"] = ex;
+  j["points"] = pts;
+
+  ojson curves = section(
+      "Per configuration, speed and load: the MTPA angle (minimum im_A over angle_deg) and the ME angle "
+      "(minimum pdcm_W), refined by the parabola through the smallest sample and its neighbours, with im_A, "
+      "pdcm_W, pm_W and efficiency read there. at_edge: the smallest sample is the first or last angle, so "
+      "the optimum may lie outside the range measured (not refined).",
+      "6.20");
+  ojson ce = ojson::array();
+  for (const auto& c : a.curves) {
+    ojson x = ojson::object();
+    put_configuration(x, c.configuration);
+    x["speed_rpm"] = c.speed_rpm;
+    x["load_Nm"] = c.load_Nm;
+    x["points"] = c.points;
+    x["angles_deg"] = c.angles_deg;
+    x["mtpa"] = optimum(c.mtpa);
+    x["me"] = optimum(c.me);
+    ce.push_back(x);
+  }
+  curves["entries"] = ce;
+  j["curves"] = curves;
+
+  ojson deltas = section(
+      "Configuration minus reference at the same speed and load, on the MTPA trajectory (at each one's own "
+      "MTPA angle) and on the ME trajectory (at each one's own ME angle).",
+      "6.21");
+  deltas["reference"] = configuration(o.reference);
+  ojson de = ojson::array();
+  for (const auto& d : a.deltas) {
+    ojson x = ojson::object();
+    put_configuration(x, d.configuration);
+    x["speed_rpm"] = d.speed_rpm;
+    x["load_Nm"] = d.load_Nm;
+    x["mtpa"] = delta(d.mtpa);
+    x["me"] = delta(d.me);
+    de.push_back(x);
+  }
+  deltas["entries"] = de;
+  j["deltas"] = deltas;
+
+  ojson hist = section(
+      "Per configuration, over all points used: counts of a record field in bins [from, to) whose edges "
+      "are multiples of bin_width, contiguous from the lowest to the highest occupied bin. from, to and "
+      "bin_width are in the field's unit (unit).",
+      "6.16-6.19");
+  ojson he = ojson::array();
+  for (const auto& h : a.histograms) {
+    ojson x = ojson::object();
+    put_configuration(x, h.configuration);
+    x["quantity"] = h.quantity;
+    x["unit"] = h.unit;
+    x["bin_width"] = h.bin_width;
+    x["count"] = h.count;
+    x["min"] = number(h.min);
+    x["mean"] = number(h.mean);
+    x["max"] = number(h.max);
+    ojson bins = ojson::array();
+    for (const auto& b : h.bins) bins.push_back({{"from", b.from}, {"to", b.to}, {"count", b.count}});
+    x["bins"] = bins;
+    he.push_back(x);
+  }
+  hist["entries"] = he;
+  j["histograms"] = hist;
+
+  // One panel per configuration and speed, load on the horizontal axis.
+  ojson pe = section(
+      "Position error against load, one panel per configuration and speed: min_deg, mean_deg, max_deg over "
+      "the angles measured of each point's window-mean error (pos_err_mean_deg); window_min_deg and "
+      "window_max_deg are the extremes seen inside the windows.",
+      "6.13-6.15");
+  ojson panels = ojson::array();
+  std::map<std::pair<Configuration, long long>, std::size_t> panel_of;
+  for (const auto& p : a.position_error) {
+    const std::pair<Configuration, long long> k{p.configuration, std::llround(p.speed_rpm * 1e6)};
+    auto it = panel_of.find(k);
+    if (it == panel_of.end()) {
+      ojson panel = ojson::object();
+      put_configuration(panel, p.configuration);
+      panel["speed_rpm"] = p.speed_rpm;
+      panel["loads"] = ojson::array();
+      it = panel_of.emplace(k, panels.size()).first;
+      panels.push_back(panel);
+    }
+    ojson x = ojson::object();
+    x["load_Nm"] = p.load_Nm;
+    x["points"] = p.points;
+    x["min_deg"] = number(p.min_deg);
+    x["mean_deg"] = number(p.mean_deg);
+    x["max_deg"] = number(p.max_deg);
+    x["window_min_deg"] = number(p.window_min_deg);
+    x["window_max_deg"] = number(p.window_max_deg);
+    panels[it->second]["loads"].push_back(x);
+  }
+  pe["entries"] = panels;
+  j["position_error"] = pe;
+
+  // Efficiency map: a speed x load matrix per configuration (null where not measured) for
+  // drawing, and the cells with their ME angle and powers.
+  ojson em = section(
+      "Per configuration: efficiency = pm_W / pdcm_W at the ME angle over speed x load. efficiency[i][j] "
+      "belongs to speeds_rpm[i] and loads_Nm[j]; null where that curve was not measured.",
+      nullptr);
+  ojson maps = ojson::array();
+  std::map<Configuration, std::vector<const EfficiencyCell*>> by_config;
+  for (const auto& c : a.efficiency) by_config[c.configuration].push_back(&c);
+  for (const auto& [config, cells] : by_config) {
+    std::vector<double> speeds, loads;
+    auto add = [](std::vector<double>& v, double x) {
+      for (double y : v)
+        if (std::fabs(y - x) < 1e-6) return;
+      v.push_back(x);
+    };
+    for (const auto* c : cells) {
+      add(speeds, c->speed_rpm);
+      add(loads, c->load_Nm);
+    }
+    std::sort(speeds.begin(), speeds.end());
+    std::sort(loads.begin(), loads.end());
+    ojson matrix = ojson::array();
+    for (double s : speeds) {
+      ojson row = ojson::array();
+      for (double l : loads) {
+        ojson v = nullptr;
+        for (const auto* c : cells)
+          if (std::fabs(c->speed_rpm - s) < 1e-6 && std::fabs(c->load_Nm - l) < 1e-6 && c->pdcm_W > 0)
+            v = number(c->efficiency);
+        row.push_back(v);
+      }
+      matrix.push_back(row);
+    }
+    ojson m = ojson::object();
+    put_configuration(m, config);
+    m["speeds_rpm"] = speeds;
+    m["loads_Nm"] = loads;
+    m["efficiency"] = matrix;
+    ojson list = ojson::array();
+    for (const auto* c : cells) {
+      ojson x = ojson::object();
+      x["speed_rpm"] = c->speed_rpm;
+      x["load_Nm"] = c->load_Nm;
+      x["angle_deg"] = number(c->angle_deg);
+      x["pm_W"] = number(c->pm_W);
+      x["pdcm_W"] = number(c->pdcm_W);
+      x["efficiency"] = c->pdcm_W > 0 ? number(c->efficiency) : ojson(nullptr);
+      x["refined"] = c->refined;
+      list.push_back(x);
+    }
+    m["cells"] = list;
+    maps.push_back(m);
+  }
+  em["entries"] = maps;
+  j["efficiency_map"] = em;
+  return j;
+}
+
+}  // namespace synbench::bench

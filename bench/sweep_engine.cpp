@@ -1,0 +1,223 @@
+// The sweep engine's state machine.
+#include "bench/sweep_engine.hpp"
+
+#include <cmath>
+
+namespace synbench::bench {
+namespace {
+
+constexpr double kStopLoadTimeout_s = 2.0;
+constexpr double kStopSpeedTimeout_s = 20.0;
+constexpr double kStoppedRpm = 20.0;
+
+Configuration config_of(const PointRequest& r) { return Configuration{r.estimator, r.pwm}; }
+
+}  // namespace
+
+std::string_view name(SweepState s) {
+  switch (s) {
+    case SweepState::running: return "running";
+    case SweepState::pausing: return "pausing";
+    case SweepState::paused: return "paused";
+    case SweepState::stopping: return "stopping";
+    case SweepState::completed: return "completed";
+    case SweepState::aborted: return "aborted";
+    case SweepState::faulted: return "faulted";
+  }
+  return "unknown";
+}
+
+SweepEngine::SweepEngine(drivers::BenchDevices devices, const SafetySupervisor& supervisor,
+                         SweepPlan plan, std::map<std::size_t, PointRecord> stored,
+                         SweepSink& sink, SweepBench bench)
+    : dev_(devices), sup_(supervisor), plan_(std::move(plan)), stored_(std::move(stored)),
+      sink_(sink), bench_(bench) {
+  options_ = point_options(plan_);
+  options_.ordered_stop_after = false;
+  options_.continue_running = true;
+  options_.load_b1_Nms_per_rad = bench_.load_b1_Nms_per_rad;
+  if (plan_.thermal.enabled)
+    options_.thermal = PointOptions::Thermal{plan_.thermal.target_C, plan_.thermal.band_C,
+                                             plan_.thermal.warmup_load_Nm, plan_.thermal.timeout_s};
+  if (plan_.mode == SweepMode::grid) {
+    grid_ = expand(plan_);
+  } else {
+    // Replay what a previous run measured, so each search continues where it stopped.
+    groups_ = plan_groups(plan_);
+    for (const auto& g : groups_) {
+      AngleSearch search(plan_.adaptive);
+      for (std::size_t e = 0; e < plan_.adaptive.max_evaluations; ++e) {
+        const auto it = stored_.find(g.group * plan_.adaptive.max_evaluations + e);
+        if (it == stored_.end()) break;
+        search.report(it->second.angle_deg, it->second.im_A, it->second.pdcm_W);
+      }
+      searches_.push_back(std::move(search));
+    }
+  }
+}
+
+SweepEngine::~SweepEngine() = default;
+
+bool SweepEngine::finished() const {
+  return state_ == SweepState::completed || state_ == SweepState::aborted ||
+         state_ == SweepState::faulted;
+}
+
+void SweepEngine::pause() {
+  if (state_ == SweepState::running) {
+    pause_requested_ = true;
+    state_ = SweepState::pausing;
+  }
+}
+
+void SweepEngine::resume() {
+  pause_requested_ = false;
+  if (state_ == SweepState::paused || state_ == SweepState::pausing) state_ = SweepState::running;
+}
+
+void SweepEngine::abort() {
+  if (!finished()) abort_requested_ = true;
+}
+
+std::optional<SweepEngine::Next> SweepEngine::next_point() {
+  if (plan_.mode == SweepMode::grid) {
+    while (grid_pos_ < grid_.size() && stored_.count(grid_[grid_pos_].index)) ++grid_pos_;
+    if (grid_pos_ == grid_.size()) return std::nullopt;
+    return Next{grid_[grid_pos_], std::nullopt};
+  }
+  for (; group_pos_ < groups_.size(); ++group_pos_) {
+    const auto& search = searches_[group_pos_];
+    if (const auto angle = search.next_angle()) {
+      return Next{adaptive_point(plan_, groups_[group_pos_], search.evaluations().size(), *angle),
+                  group_pos_};
+    }
+  }
+  return std::nullopt;
+}
+
+void SweepEngine::start_point(const Next& n, double now_s) {
+  current_ = n;
+  proc_ = std::make_unique<PointProcedure>(dev_, n.point.request, options_);
+  proc_->tick(now_s);
+}
+
+void SweepEngine::finish_point(double /*now_s*/) {
+  const Next n = *current_;
+  current_.reset();
+  auto proc = std::move(proc_);
+  if (!proc->has_record()) {
+    // A device refused a command (the supervisor catches faults): nothing sensible to go on with.
+    if (sup_.may_command()) {
+      error_ = "point " + std::to_string(n.point.index) + ": " + proc->error();
+      sink_.event("fault", error_);
+      begin_stop(SweepState::faulted, now_);
+    }
+    return;
+  }
+  const PointRecord& r = proc->record();
+  if (const auto ec = sink_.store_point(n.point.index, r)) {
+    error_ = "storing point " + std::to_string(n.point.index) + " failed: " + ec.message();
+    sink_.event("fault", error_);
+    begin_stop(SweepState::faulted, now_);
+    return;
+  }
+  stored_[n.point.index] = r;
+  ++measured_this_run_;
+  running_config_ = config_of(n.point.request);
+  if (n.search) searches_[*n.search].report(r.angle_deg, r.im_A, r.pdcm_W);
+  if (plan_.mode == SweepMode::grid) ++grid_pos_;
+  sink_.progress(progress());
+}
+
+void SweepEngine::begin_stop(SweepState final_state, double now_s) {
+  stopping_ = true;
+  after_stop_ = final_state;
+  stop_since_s_ = now_s;
+  if (final_state != SweepState::running) state_ = SweepState::stopping;
+  dev_.load->set_torque_Nm(0.0);
+}
+
+void SweepEngine::tick_stop(double now_s) {
+  const auto& st = sup_.synrm();
+  const auto& lt = sup_.load();
+  const bool load_gone = lt && std::fabs(lt->torque_Nm) < 0.05;
+  if (load_gone || now_s - stop_since_s_ > kStopLoadTimeout_s) dev_.synrm->set_speed_rpm(0.0);
+  const bool still = st && std::fabs(st->speed_rpm) < kStoppedRpm;
+  if ((still && load_gone) || now_s - stop_since_s_ > kStopSpeedTimeout_s) {
+    dev_.synrm->enable(false);
+    dev_.load->enable(false);
+    stopping_ = false;
+    running_config_.reset();
+    state_ = after_stop_;
+    sink_.event("state", after_stop_ == SweepState::running
+                             ? std::string("drives stopped to switch configuration")
+                             : "sweep " + std::string(name(state_)));
+    sink_.progress(progress());
+  }
+}
+
+void SweepEngine::tick(double now_s) {
+  now_ = now_s;
+  if (t0_ < 0) t0_ = now_s;
+  if (finished()) return;
+  if (!sup_.may_command()) {
+    // The supervisor has already brought the bench to its ordered stop.
+    proc_.reset();
+    current_.reset();
+    stopping_ = false;
+    state_ = SweepState::faulted;
+    error_ = "safety supervisor tripped: " +
+             (sup_.trip() ? std::string(drivers::fault_name(sup_.trip()->fault)) + " (" + sup_.trip()->detail + ")"
+                          : std::string("unknown"));
+    sink_.event("state", "sweep faulted: " + error_);
+    sink_.progress(progress());
+    return;
+  }
+  if (stopping_) return tick_stop(now_s);
+  if (proc_) {
+    if (abort_requested_) {
+      proc_.reset();
+      current_.reset();
+      return begin_stop(SweepState::aborted, now_s);
+    }
+    proc_->tick(now_s);
+    if (!proc_->finished()) return;
+    finish_point(now_s);
+    return;
+  }
+  if (abort_requested_) return begin_stop(SweepState::aborted, now_s);
+  if (pause_requested_) {
+    if (state_ != SweepState::paused) {
+      state_ = SweepState::paused;
+      sink_.event("state", "sweep paused");
+      sink_.progress(progress());
+    }
+    return;
+  }
+  const auto n = next_point();
+  if (!n) return begin_stop(SweepState::completed, now_s);
+  if (running_config_ && *running_config_ != config_of(n->point.request))
+    return begin_stop(SweepState::running, now_s);
+  start_point(*n, now_s);
+}
+
+SweepProgress SweepEngine::progress() const {
+  SweepProgress p;
+  p.state = state_;
+  p.done = stored_.size();
+  if (plan_.mode == SweepMode::grid) {
+    p.total = grid_.size();
+  } else {
+    for (std::size_t g = 0; g < searches_.size(); ++g)
+      p.total += searches_[g].finished() ? searches_[g].evaluations().size()
+                                          : plan_.adaptive.max_evaluations;
+  }
+  if (current_) p.current_index = current_->point.index;
+  p.bench_elapsed_s = t0_ < 0 ? 0.0 : now_ - t0_;
+  if (measured_this_run_ > 0 && p.total >= p.done)
+    p.eta_s = p.bench_elapsed_s / static_cast<double>(measured_this_run_) *
+              static_cast<double>(p.total - p.done);
+  return p;
+}
+
+}  // namespace synbench::bench

@@ -1,0 +1,186 @@
+// A sweep plan: what a measurement campaign measures and how (docs/sweep-plan.md). Parsed from
+// JSON with every problem reported at its JSON pointer, expanded into a deterministic list of
+// points whose index is the resume key stored in the database, and written back as canonical
+// JSON (stored with the sweep). Pure logic: no I/O besides the JSON given, no clock.
+#pragma once
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench/point_procedure.hpp"
+#include "bench/steady_state.hpp"
+#include "bench/sweep_plan_angle_search.hpp"
+#include "bench/sweep_plan_configuration.hpp"
+
+namespace synbench::bench {
+
+// A configuration as planned: measured only at speeds within [min_speed_rpm, max_speed_rpm]
+// (the thesis measured the EEMF variants only from 500 rpm).
+struct PlannedConfiguration {
+  Configuration configuration;
+  double min_speed_rpm = 0;
+  std::optional<double> max_speed_rpm;  // none: no upper restriction
+  bool operator==(const PlannedConfiguration&) const = default;
+};
+
+// One (speed, load) pair given explicitly, for point sets that are not a speed x load grid
+// (the IEC 61800-9-2 points).
+struct OperatingPoint {
+  double speed_rpm = 0;
+  double load_Nm = 0;
+  std::string label;  // e.g. "IEC 61800-9-2 (50 %, 25 %)"; may be empty
+  bool operator==(const OperatingPoint&) const = default;
+};
+
+enum class SweepDimension { speed, load, config, angle };
+enum class SweepMode { grid, adaptive };
+
+// The steady-state gate of every point: bands and slopes (SteadyStateBands), the least settling
+// time after the load is applied, and the timeout after which the point is measured anyway and
+// recorded as unstable (never dropped).
+struct GateOptions {
+  SteadyStateBands bands;
+  double min_settle_s = 0.5;
+  double timeout_s = 30.0;
+  bool operator==(const GateOptions& o) const;
+};
+
+// Thermal precondition: measure only with the winding within target_C +/- band_C. Below it the
+// sweep warms the machine with warmup_load_Nm (at warmup_speed_rpm, or at the next point's speed
+// when none); above it, it waits unloaded. timeout_s bounds one wait.
+struct ThermalOptions {
+  bool enabled = true;
+  double target_C = 50.0;
+  double band_C = 5.0;
+  double warmup_load_Nm = 3.5;
+  std::optional<double> warmup_speed_rpm;
+  double timeout_s = 3600.0;
+  bool operator==(const ThermalOptions&) const = default;
+};
+
+// Limits of the run. The first five match bench::SafetyLimits' meaning and defaults; the plan's
+// setpoints are checked against max_speed_rpm and max_load_Nm when it is parsed.
+struct SweepLimits {
+  double max_speed_rpm = 1650.0;
+  double max_current_A = 5.0;
+  double max_udc_V = 445.0;
+  double min_udc_V = 320.0;
+  double max_temp_C = 110.0;
+  double max_load_Nm = 3.5;  // rated torque of the SynRM
+  bool operator==(const SweepLimits&) const = default;
+};
+
+inline constexpr std::array<SweepDimension, 4> kDefaultOrder{SweepDimension::speed, SweepDimension::load,
+                                                             SweepDimension::config, SweepDimension::angle};
+
+struct SweepPlan {
+  std::string name;
+  std::string preset;  // the preset the plan was built from ("" when none); informational
+  // Grid dimensions. speeds_rpm x loads_Nm unless operating_points is not empty, which then
+  // replaces both. angles_deg is empty in adaptive mode (the search picks the angles).
+  std::vector<double> speeds_rpm, loads_Nm, angles_deg;
+  std::vector<OperatingPoint> operating_points;
+  std::vector<PlannedConfiguration> configurations;
+  std::array<SweepDimension, 4> order = kDefaultOrder;  // outermost first
+  SweepMode mode = SweepMode::grid;
+  AngleSearchOptions adaptive;  // used in adaptive mode
+  GateOptions gate;
+  double window_s = 1.0;
+  ThermalOptions thermal;
+  SweepLimits limits;
+  std::vector<std::string> notes;  // how the plan was built, e.g. how a preset treats a point
+  bool operator==(const SweepPlan&) const = default;
+};
+
+// One problem in a plan document: RFC 6901 JSON pointer ("" for the whole document) and reason.
+struct SweepPlanError {
+  std::string json_pointer;
+  std::string reason;
+};
+// "/dimensions/speed_rpm/1: must be > 0"
+std::string to_string(const SweepPlanError& e);
+
+struct SweepPlanParseResult {
+  std::optional<SweepPlan> plan;        // set exactly when errors is empty
+  std::vector<SweepPlanError> errors;   // every problem, not only the first
+};
+
+SweepPlanParseResult parse_sweep_plan(const nlohmann::json& doc);
+
+// Canonical form: every field explicit (defaults filled in, ranges and presets expanded into
+// lists) in a fixed key order. parse_sweep_plan(to_json(p)) gives p back.
+nlohmann::ordered_json to_json(const SweepPlan& plan);
+
+// The (speed, load, configuration) curves of a plan, numbered in sweep order. An adaptive search
+// works on one group; in grid mode a group is the angle sweep at one (speed, load, config).
+struct PlannedGroup {
+  std::size_t group = 0;
+  double speed_rpm = 0;
+  double load_Nm = 0;
+  PlannedConfiguration configuration;
+};
+
+struct PlannedPoint {
+  std::size_t index;      // position in the sweep; the resume key stored with the measured point
+  PointRequest request;
+  std::size_t group;      // PlannedGroup::group of its (speed, load, configuration)
+};
+
+// Groups in sweep order (both modes).
+std::vector<PlannedGroup> plan_groups(const SweepPlan& plan);
+
+// Grid mode: every point in sweep order, index 0, 1, 2, ... Adaptive mode: empty (the angles are
+// not known in advance); use plan_groups() and adaptive_point().
+std::vector<PlannedPoint> expand(const SweepPlan& plan);
+
+// Adaptive mode: the request for evaluation `evaluation` (0-based, < adaptive.max_evaluations)
+// of a group at the angle the search proposed. index = group * max_evaluations + evaluation,
+// so indices grow in sweep order and stay stable however many points a search needs.
+PlannedPoint adaptive_point(const SweepPlan& plan, const PlannedGroup& group, std::size_t evaluation,
+                            double angle_deg);
+
+// The point procedure's options for this plan's gate (other fields keep PointOptions' defaults).
+PointOptions point_options(const SweepPlan& plan);
+
+// Bench-time model (docs/sweep-plan.md): per point, settling (the larger of the gate's
+// min_settle_s and span_s, plus settle_extra_s) and the window; ramps for every speed and load
+// change (from and back to standstill at the ends); a fixed cost per configuration change (the
+// engine stops and restarts the drive to switch estimator or PWM). Thermal waits are not
+// included: they depend on the machine's state.
+struct SweepTimeModel {
+  double speed_ramp_rpm_per_s = 1000.0;   // firmware speed ramp
+  double load_ramp_Nm_per_s = 10.0;       // load drive torque ramp
+  double settle_extra_s = 1.0;            // transients beyond the gate's minimum
+  double configuration_change_s = 10.0;   // ordered stop, switch, restart
+};
+
+struct SweepEstimate {
+  std::size_t points = 0;        // adaptive: groups x max_evaluations, an upper bound
+  std::size_t groups = 0;
+  std::size_t speed_changes = 0;
+  std::size_t load_changes = 0;
+  std::size_t configuration_changes = 0;
+  double bench_time_s = 0;
+  bool upper_bound = false;      // true in adaptive mode
+};
+
+SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& model = {});
+nlohmann::ordered_json to_json(const SweepEstimate& e);
+
+// from, from + step, ..., to: inclusive, each value computed as from + i * step (no accumulated
+// error) and rounded to 1e-9, with `to` included when it lies within 1e-6 steps of the grid.
+// Empty for step <= 0 or from > to.
+std::vector<double> inclusive_range(double from, double to, double step);
+
+std::string_view name(SweepDimension d);
+std::string_view name(SweepMode m);
+// "speed-load-config-angle"
+std::string order_name(const std::array<SweepDimension, 4>& order);
+
+}  // namespace synbench::bench

@@ -1,0 +1,299 @@
+// `synbench sweep`: runs a sweep plan headless on the in-process twin, every point committed to
+// the SQLite store as it is measured; resumable after a crash or an abort; exports and analysis.
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <unistd.h>
+
+#include "bench/analysis.hpp"
+#include "bench/safety_supervisor.hpp"
+#include "bench/sweep_engine.hpp"
+#include "bench/sweep_plan.hpp"
+#include "db/export.hpp"
+#include "db/store.hpp"
+#include "emulator/twin_bench.hpp"
+#include "emulator/twin_config_schema.hpp"
+#include "server/cli/args.hpp"
+#include "server/cli/commands.hpp"
+
+namespace synbench::cli {
+
+const char* const kSweepHelp = R"(usage: synbench sweep PLAN.json [options]
+       synbench sweep --resume ID [options]
+
+Runs a sweep plan (docs/sweep-plan.md) headless on the in-process twin, on virtual time, as fast
+as the CPU allows. Every measured point is committed to the SQLite database before the next one
+starts; a sweep interrupted by a crash, a fault or Ctrl-C resumes at its first missing point.
+
+options:
+  --db FILE           database file (default synbench.db; created if missing)
+  --resume ID         continue sweep ID from the database (its stored plan is used)
+  --config FILE       twin config JSON (docs/emulator-config.md)
+  --export-csv FILE   write the sweep's points as CSV when it ends
+  --export-json FILE  write the sweep's points as JSON when it ends
+  --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
+  --quiet             no progress output
+  --help              this text
+
+A progress bar with ETA is drawn on a terminal; otherwise a plain line every 10 s.
+exit status: 0 completed, 1 faulted or failed, 2 bad input, 130 aborted (Ctrl-C)
+)";
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+void on_sigint(int) { g_interrupted = true; }
+
+std::string hms(double s) {
+  const long t = static_cast<long>(s + 0.5);
+  char buf[32];
+  if (t >= 3600)
+    std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+  return buf;
+}
+
+// Persists points and events in the store and draws progress.
+class StoreSink final : public bench::SweepSink {
+ public:
+  StoreSink(db::Store& store, std::int64_t sweep_id, bool quiet)
+      : store_(store), id_(sweep_id), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0),
+        start_(std::chrono::steady_clock::now()) {}
+
+  std::error_code store_point(std::size_t index, const bench::PointRecord& r) override {
+    const auto st = store_.insert_point(id_, static_cast<std::int64_t>(index), r);
+    if (!st) last_error_ = st.error().message;
+    ++stored_this_run_;
+    return st.code();
+  }
+  void event(const std::string& kind, const std::string& message) override {
+    const auto k = kind == "fault" ? db::EventKind::fault : kind == "state" ? db::EventKind::state : db::EventKind::log;
+    (void)store_.add_event(id_, k, message);
+    if (!quiet_ && kind == "fault") std::cerr << (tty_ ? "\n" : "") << "fault: " << message << "\n";
+  }
+  void progress(const bench::SweepProgress& p) override {
+    if (quiet_) return;
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double frac = p.total ? static_cast<double>(p.done) / static_cast<double>(p.total) : 1.0;
+    std::string eta = "-";
+    if (stored_this_run_ > 0 && p.total >= p.done)
+      eta = hms(wall / static_cast<double>(stored_this_run_) * static_cast<double>(p.total - p.done));
+    if (tty_) {
+      const int width = 30, fill = static_cast<int>(frac * width);
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu %3.0f%%  ETA %s  bench %s  %s   ",
+                   std::string(static_cast<std::size_t>(fill), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - fill), '.').c_str(), p.done, p.total,
+                   100 * frac, eta.c_str(), hms(p.bench_elapsed_s).c_str(),
+                   std::string(bench::name(p.state)).c_str());
+    } else if (wall - last_line_ >= 10.0 || p.done == p.total) {
+      last_line_ = wall;
+      std::fprintf(stderr, "sweep %lld: %zu/%zu points (%.0f %%), ETA %s, bench time %s, %s\n",
+                   static_cast<long long>(id_), p.done, p.total, 100 * frac, eta.c_str(),
+                   hms(p.bench_elapsed_s).c_str(), std::string(bench::name(p.state)).c_str());
+    }
+  }
+  void finish_line() const {
+    if (!quiet_ && tty_) std::fprintf(stderr, "\n");
+  }
+  const std::string& last_error() const { return last_error_; }
+
+ private:
+  db::Store& store_;
+  std::int64_t id_;
+  bool quiet_, tty_;
+  std::chrono::steady_clock::time_point start_;
+  std::size_t stored_this_run_ = 0;
+  double last_line_ = -1e9;
+  std::string last_error_;
+};
+
+bool write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  return static_cast<bool>(out);
+}
+
+bench::SafetyLimits limits_of(const bench::SweepPlan& plan) {
+  bench::SafetyLimits l;
+  l.max_speed_rpm = plan.limits.max_speed_rpm;
+  l.max_current_A = plan.limits.max_current_A;
+  l.max_udc_V = plan.limits.max_udc_V;
+  l.min_udc_V = plan.limits.min_udc_V;
+  l.max_temp_C = plan.limits.max_temp_C;
+  return l;
+}
+
+}  // namespace
+
+int sweep_command(const std::vector<std::string>& argv) {
+  emulator::TwinConfig config;
+  std::optional<bench::SweepPlan> plan;
+  std::string db_path = "synbench.db";
+  std::optional<std::int64_t> resume;
+  std::optional<std::string> csv, json_out, analysis_out;
+  bool quiet = false;
+  try {
+    Args a(argv, {"--quiet", "--help"},
+           {"--db", "--resume", "--config", "--export-csv", "--export-json", "--analysis"});
+    if (a.has("--help")) {
+      std::cout << kSweepHelp;
+      return 0;
+    }
+    quiet = a.has("--quiet");
+    if (auto v = a.text("--db")) db_path = *v;
+    csv = a.text("--export-csv");
+    json_out = a.text("--export-json");
+    analysis_out = a.text("--analysis");
+    if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+    if (auto r = a.number("--resume")) {
+      if (*r < 1 || *r != std::floor(*r)) throw UsageError("--resume", "must be a sweep id (a whole number >= 1)");
+      resume = static_cast<std::int64_t>(*r);
+      if (!a.positional().empty()) throw UsageError(a.positional().front(), "a resumed sweep uses its stored plan");
+    } else {
+      if (a.positional().size() != 1) throw UsageError("PLAN.json", "exactly one plan file is required");
+      const std::string& file = a.positional().front();
+      std::ifstream in(file);
+      if (!in) throw UsageError("PLAN.json", "cannot open '" + file + "'");
+      nlohmann::json doc;
+      try {
+        doc = nlohmann::json::parse(in);
+      } catch (const nlohmann::json::parse_error& e) {
+        throw UsageError("PLAN.json", "'" + file + "' is not valid JSON: " + e.what());
+      }
+      auto parsed = bench::parse_sweep_plan(doc);
+      if (!parsed.errors.empty()) {
+        for (const auto& e : parsed.errors) std::cerr << "synbench sweep: " << file << ": " << bench::to_string(e) << "\n";
+        return 2;
+      }
+      plan = std::move(parsed.plan);
+    }
+  } catch (const UsageError& e) {
+    std::cerr << "synbench sweep: " << e.what() << "\n";
+    return 2;
+  } catch (const emulator::ConfigError& e) {
+    std::cerr << "synbench sweep: --config: " << e.what() << "\n";
+    return 2;
+  }
+
+  auto opened = db::Store::open(db_path);
+  if (!opened) {
+    std::cerr << "synbench sweep: --db " << db_path << ": " << opened.error().message << "\n";
+    return 1;
+  }
+  db::Store store = std::move(*opened);
+
+  std::int64_t id = 0;
+  std::map<std::size_t, bench::PointRecord> stored;
+  if (resume) {
+    auto sweep = store.get_sweep(*resume);
+    if (!sweep) {
+      std::cerr << "synbench sweep: --resume " << *resume << ": " << sweep.error().message << "\n";
+      return 2;
+    }
+    if (sweep->state == db::SweepState::completed) {
+      std::cerr << "synbench sweep: --resume " << *resume << ": the sweep is already completed\n";
+      return 2;
+    }
+    auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(sweep->meta.plan.dump()));
+    if (!parsed.plan) {
+      std::cerr << "synbench sweep: --resume " << *resume << ": its stored plan no longer parses: "
+                << bench::to_string(parsed.errors.front()) << "\n";
+      return 1;
+    }
+    plan = std::move(parsed.plan);
+    auto rows = store.points(*resume);
+    if (!rows) {
+      std::cerr << "synbench sweep: " << rows.error().message << "\n";
+      return 1;
+    }
+    for (const auto& row : *rows) stored[static_cast<std::size_t>(row.index)] = row.record;
+    id = *resume;
+  } else {
+    db::SweepMeta meta;
+    meta.name = plan->name.empty() ? "sweep" : plan->name;
+    meta.plan = bench::to_json(*plan);
+    meta.bench_config = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+    const auto est = bench::estimate(*plan);
+    meta.total_points = static_cast<std::int64_t>(est.points);
+    auto created = store.create_sweep(meta);
+    if (!created) {
+      std::cerr << "synbench sweep: " << created.error().message << "\n";
+      return 1;
+    }
+    id = *created;
+  }
+  const bool sparse = plan->mode == bench::SweepMode::adaptive;
+  if (!quiet) std::cerr << "sweep " << id << " (" << db_path << "): " << stored.size() << " points stored before this run\n";
+  (void)store.set_sweep_state(id, db::SweepState::running);
+
+  emulator::TwinBench twin(config);
+  bench::SafetySupervisor supervisor(twin.devices(), limits_of(*plan), [&](const std::string& k, const std::string& m) {
+    (void)store.add_event(id, k == "fault" ? db::EventKind::fault : db::EventKind::state, m);
+  });
+  StoreSink sink(store, id, quiet);
+  bench::SweepBench bench_cal;
+  bench_cal.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
+  bench::SweepEngine engine(twin.devices(), supervisor, *plan, std::move(stored), sink, bench_cal);
+
+  g_interrupted = false;
+  auto previous = std::signal(SIGINT, on_sigint);
+  const double tick_s = 0.01;
+  double t = twin.clock().now_s();
+  bool abort_sent = false;
+  while (!engine.finished()) {
+    if (g_interrupted && !abort_sent) {
+      engine.abort();
+      abort_sent = true;
+      if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
+    }
+    t += tick_s;
+    twin.clock().wait_until(t);
+    supervisor.tick(t);
+    engine.tick(t);
+  }
+  std::signal(SIGINT, previous);
+  sink.finish_line();
+
+  const auto final_state = engine.state() == bench::SweepState::completed ? db::SweepState::completed
+                           : engine.state() == bench::SweepState::aborted ? db::SweepState::aborted
+                                                                          : db::SweepState::faulted;
+  std::optional<std::string> err;
+  if (!engine.error().empty()) err = engine.error();
+  if (auto st = store.set_sweep_state(id, final_state, err, sparse); !st)
+    std::cerr << "synbench sweep: recording the final state: " << st.error().message << "\n";
+
+  auto rows = store.points(id);
+  if (!rows) {
+    std::cerr << "synbench sweep: " << rows.error().message << "\n";
+    return 1;
+  }
+  int status = final_state == db::SweepState::completed ? 0 : final_state == db::SweepState::aborted ? 130 : 1;
+  if (csv && !write_file(*csv, db::points_to_csv(*rows))) {
+    std::cerr << "synbench sweep: --export-csv: cannot write '" << *csv << "'\n";
+    status = 1;
+  }
+  if (json_out && !write_file(*json_out, db::points_to_json(*rows).dump(1) + "\n")) {
+    std::cerr << "synbench sweep: --export-json: cannot write '" << *json_out << "'\n";
+    status = 1;
+  }
+  if (analysis_out) {
+    std::vector<bench::PointRecord> records;
+    for (const auto& r : *rows) records.push_back(r.record);
+    if (!write_file(*analysis_out, bench::to_json(bench::analyze(records)).dump(1) + "\n")) {
+      std::cerr << "synbench sweep: --analysis: cannot write '" << *analysis_out << "'\n";
+      status = 1;
+    }
+  }
+  if (!quiet)
+    std::cerr << "sweep " << id << " " << db::name(final_state) << ": " << rows->size() << " points in " << db_path
+              << (engine.error().empty() ? "" : " (" + engine.error() + ")") << "\n";
+  return status;
+}
+
+}  // namespace synbench::cli

@@ -1,0 +1,163 @@
+// The sweep engine on the twin: completes a plan in order, stores every point once, resumes at
+// the missing points, stops the drive to switch configuration, pauses, aborts, and ends faulted
+// when the supervisor trips.
+#include "bench/sweep_engine.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <vector>
+
+#include "drivers/error.hpp"
+#include "emulator/twin_bench.hpp"
+
+namespace synbench::bench {
+namespace {
+
+struct VectorSink : SweepSink {
+  std::vector<std::pair<std::size_t, PointRecord>> points;
+  std::vector<std::string> events;
+  std::size_t fail_at = static_cast<std::size_t>(-1);
+  std::error_code store_point(std::size_t index, const PointRecord& r) override {
+    if (points.size() == fail_at) return make_error_code(errc::disconnected);
+    points.emplace_back(index, r);
+    return {};
+  }
+  void event(const std::string& kind, const std::string& message) override {
+    events.push_back(kind + ": " + message);
+  }
+};
+
+SweepPlan plan_from(const char* json) {
+  auto r = parse_sweep_plan(nlohmann::json::parse(json));
+  EXPECT_TRUE(r.errors.empty()) << (r.errors.empty() ? "" : to_string(r.errors.front()));
+  return *r.plan;
+}
+
+const char* kSmall = R"({
+  "name": "small",
+  "dimensions": {"speed_rpm": [500, 700], "load_Nm": [1.0, 2.0], "angle_deg": [50, 56, 62]},
+  "window_s": 0.5,
+  "thermal": {"enabled": false}
+})";
+
+struct TwinRun {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  SafetySupervisor sup{bench.devices(), SafetyLimits{}};
+  double t = 0;
+  template <class F>
+  void until(SweepEngine& e, double max_s, F&& hook) {
+    while (!e.finished() && t < max_s) {
+      t += 0.01;
+      bench.clock().wait_until(t);
+      sup.tick(t);
+      e.tick(t);
+      hook(t);
+    }
+  }
+  void until(SweepEngine& e, double max_s) {
+    until(e, max_s, [](double) {});
+  }
+};
+
+TEST(SweepEngine, CompletesAGridInOrderAndEndsStopped) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(kSmall), {}, sink);
+  run.until(e, 600);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 12u);
+  for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(sink.points[i].first, i);
+  const auto& first = sink.points.front().second;
+  EXPECT_EQ(first.speed_rpm, 500);
+  EXPECT_EQ(first.load_Nm, 1.0);
+  EXPECT_EQ(first.angle_deg, 50);
+  EXPECT_EQ(sink.points.back().second.angle_deg, 62);
+  for (const auto& [i, r] : sink.points) {
+    EXPECT_NEAR(r.speed_meas_rpm, r.speed_rpm, 1.0) << i;
+    EXPECT_GT(r.pdcm_W, r.pm_W) << i;
+    EXPECT_FALSE(r.unstable) << i;
+  }
+  EXPECT_EQ(run.bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+  run.bench.clock().wait_until(run.t + 5.0);  // disabled below 20 rpm, the shaft coasts out
+  EXPECT_LT(std::fabs(run.bench.twin().snapshot().speed_rpm), 5.0);
+  // Chained points are quicker than from standstill.
+  EXPECT_LT(sink.points[1].second.settle_s, sink.points[0].second.settle_s);
+}
+
+TEST(SweepEngine, ResumesAtTheMissingPointsOnly) {
+  TwinRun run;
+  VectorSink first;
+  first.fail_at = 5;  // the "crash": storing the sixth point fails
+  SweepEngine e1(run.bench.devices(), run.sup, plan_from(kSmall), {}, first);
+  run.until(e1, 600);
+  EXPECT_EQ(e1.state(), SweepState::faulted);
+  ASSERT_EQ(first.points.size(), 5u);
+
+  TwinRun again;
+  std::map<std::size_t, PointRecord> stored(first.points.begin(), first.points.end());
+  VectorSink second;
+  SweepEngine e2(again.bench.devices(), again.sup, plan_from(kSmall), stored, second);
+  again.until(e2, 600);
+  ASSERT_EQ(e2.state(), SweepState::completed) << e2.error();
+  ASSERT_EQ(second.points.size(), 7u);
+  for (std::size_t i = 0; i < 7; ++i) EXPECT_EQ(second.points[i].first, i + 5);
+}
+
+TEST(SweepEngine, StopsTheDriveToSwitchConfiguration) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(R"({
+    "dimensions": {"speed_rpm": [700], "load_Nm": [2.0], "angle_deg": [56],
+                   "configurations": [{"estimator": "encoder", "pwm": "capwm"},
+                                      {"estimator": "ekf-basic", "pwm": "aspwm"}]},
+    "window_s": 0.5, "thermal": {"enabled": false}})"), {}, sink);
+  run.until(e, 600);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 2u);
+  EXPECT_EQ(sink.points[1].second.estimator, drivers::Estimator::ekf_basic);
+  ASSERT_TRUE(sink.points[1].second.pos_err_mean_deg);
+  EXPECT_LT(std::fabs(*sink.points[1].second.pos_err_mean_deg), 7.5);
+  bool switched = false;
+  for (const auto& ev : sink.events) switched = switched || ev.find("switch configuration") != std::string::npos;
+  EXPECT_TRUE(switched);
+}
+
+TEST(SweepEngine, PausesBetweenPointsAndAbortsToAnOrderedStop) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(kSmall), {}, sink);
+  bool paused_once = false;
+  run.until(e, 600, [&](double) {
+    if (sink.points.size() == 2 && !paused_once) {
+      e.pause();
+      paused_once = true;
+    }
+    if (e.state() == SweepState::paused) {
+      EXPECT_EQ(sink.points.size(), 2u);
+      if (run.t > 60) e.abort();
+    }
+  });
+  EXPECT_EQ(e.state(), SweepState::aborted);
+  EXPECT_EQ(sink.points.size(), 2u);
+  EXPECT_EQ(run.bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+  run.bench.clock().wait_until(run.t + 5.0);
+  EXPECT_LT(std::fabs(run.bench.twin().snapshot().speed_rpm), 5.0);
+}
+
+TEST(SweepEngine, EndsFaultedWhenTheSupervisorTrips) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(kSmall), {}, sink);
+  run.until(e, 600, [&](double) {
+    if (sink.points.size() == 3) run.bench.twin().set_winding_temp_C(115.0);
+  });
+  EXPECT_EQ(e.state(), SweepState::faulted);
+  EXPECT_NE(e.error().find("overtemperature"), std::string::npos) << e.error();
+  EXPECT_LE(sink.points.size(), 4u);
+  EXPECT_TRUE(run.sup.tripped());
+}
+
+}  // namespace
+}  // namespace synbench::bench
