@@ -131,5 +131,25 @@ gaps = {s: sum(curves[(s, l)]["me"]["angle_deg"] - curves[(s, l)]["mtpa"]["angle
 check(all(curves[k]["me"]["angle_deg"] > curves[k]["mtpa"]["angle_deg"] for k in curves), "ME above MTPA everywhere")
 check(gaps[900.0] > gaps[500.0] > gaps[100.0], f"the ME-MTPA gap grows with speed {gaps}")
 
+# --- adaptive search on the same grid: MTPA and ME within +/-1 deg with at most a third of the points
+adaptive = write("adaptive.json", {"preset": "thesis-grid", "mode": "adaptive",
+                                   "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
+db = os.path.join(tmp, "adaptive.db")
+ad_path = os.path.join(tmp, "adaptive-analysis.json")
+code, out, err = run(adaptive, "--db", db, "--analysis", ad_path, "--quiet", timeout=1200)
+check(code == 0, "adaptive thesis grid completes")
+con = sqlite3.connect(db)
+n_adaptive = con.execute("select count(*) from points").fetchone()[0]
+state = con.execute("select state from sweeps where id = 1").fetchone()[0]
+con.close()
+ad = {(e["speed_rpm"], e["load_Nm"]): e for e in json.load(open(ad_path))["curves"]["entries"]}
+worst_mtpa = max(abs(ad[k]["mtpa"]["angle_deg"] - curves[k]["mtpa"]["angle_deg"]) for k in curves)
+worst_me = max(abs(ad[k]["me"]["angle_deg"] - curves[k]["me"]["angle_deg"]) for k in curves)
+print(f"     adaptive: {n_adaptive} points vs 665 ({n_adaptive / 665:.2f}), worst MTPA {worst_mtpa:.2f} deg, "
+      f"worst ME {worst_me:.2f} deg")
+check(state == "completed", f"adaptive sweep recorded as completed ({state})")
+check(n_adaptive * 3 <= 665, f"at most a third of the grid's measurements ({n_adaptive})")
+check(worst_mtpa <= 1.0 and worst_me <= 1.0, "MTPA and ME within +/-1 deg of the full grid on every curve")
+
 print(f"{'all' if not failures else len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
 sys.exit(1 if failures else 0)
