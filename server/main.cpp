@@ -14,9 +14,10 @@ synbench runs efficiency experiments on a synchronous reluctance motor test benc
 built-in twin.
 
 commands:
-  point     measure one operating point on the in-process twin
+  point     measure one operating point (in-process twin, or devices of a bench config)
   sweep     run a sweep plan on the twin, stored in SQLite, resumable
   config    print or check the twin's configuration
+  emulate   serve the twin over Modbus TCP or RTU
 
   synbench <command> --help    options of a command
   synbench --version           version
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   if (command == "point") return synbench::cli::point_command(args);
   if (command == "config") return synbench::cli::config_command(args);
   if (command == "sweep") return synbench::cli::sweep_command(args);
+  if (command == "emulate") return synbench::cli::emulate_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

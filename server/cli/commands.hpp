@@ -10,9 +10,11 @@ namespace synbench::cli {
 int point_command(const std::vector<std::string>& args);
 int config_command(const std::vector<std::string>& args);
 int sweep_command(const std::vector<std::string>& args);
+int emulate_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
 extern const char* const kSweepHelp;
+extern const char* const kEmulateHelp;
 
 }  // namespace synbench::cli

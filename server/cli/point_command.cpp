@@ -1,13 +1,17 @@
-// `synbench point`: one operating point on the in-process twin, on virtual time.
+// `synbench point`: one operating point on the in-process twin, on virtual time; or, with
+// --bench, through device profiles and Modbus links (hardware, `synbench emulate`).
 #include <nlohmann/json.hpp>
 
 #include <iostream>
+#include <memory>
 
 #include "bench/point_procedure.hpp"
+#include "drivers/bench_config.hpp"
 #include "emulator/firmware/estimators/factory.hpp"
 #include "emulator/twin_bench.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
+#include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
 
 namespace synbench::cli {
@@ -17,6 +21,8 @@ const char* const kPointHelp = R"(usage: synbench point --speed-rpm N --load-Nm 
 Runs one operating point on the in-process twin of the bench, on virtual time (as fast as the
 CPU allows): starts the drives, brings the bench to the point, waits for steady state, measures
 one window on every instrument at once, prints one record, and ends with the ordered stop.
+With --bench, the same procedure runs through the device profiles and Modbus links the bench
+config names: on real drives, on `synbench emulate`, or on the twin's register map in-process.
 
 required:
   --speed-rpm N      SynRM speed setpoint, 0 < N <= firmware.max_speed_rpm (1500)
@@ -25,12 +31,16 @@ required:
 
 options:
   --pwm S            capwm (default) or aspwm
-  --estimator E      position source: encoder (default), ekf-basic, ekf-rs, hfi
+  --estimator E      position source: encoder (default), ekf-basic, ekf-rs (with aspwm),
+                     hfi, eemf-const, eemf-lut, eemf-rls (docs/estimators.md)
   --udc-V V          DC-bus source voltage; chopper and trips scale with it (default 425)
   --window-s S       measurement window (VFC gate), s (default 1)
   --temp-C T         winding temperature at start (default 50, the bench setpoint)
   --config FILE      twin config JSON (partial: overrides the defaults; see docs/emulator-config.md)
   --seed N           noise seed (default from config)
+  --bench FILE       bench config JSON: profile and link of each device (docs/bench-config.md);
+                     --config, --seed, --udc-V and --temp-C apply only when its links are the
+                     in-process twin (give them to `synbench emulate` otherwise)
   --json             print the record as one JSON object (field names: docs/record.md)
   --help             this text
 
@@ -69,10 +79,12 @@ int point_command(const std::vector<std::string>& argv) {
   emulator::TwinConfig config;
   bench::PointRequest req;
   bool json = false;
+  std::optional<drivers::BenchConfig> bench_config;
+  std::optional<drivers::BenchProfiles> profiles;
   try {
     Args a(argv, {"--json", "--help"},
            {"--speed-rpm", "--load-Nm", "--angle-deg", "--pwm", "--estimator", "--udc-V",
-            "--window-s", "--temp-C", "--config", "--seed"});
+            "--window-s", "--temp-C", "--config", "--seed", "--bench"});
     if (a.has("--help")) {
       std::cout << kPointHelp;
       return 0;
@@ -121,6 +133,22 @@ int point_command(const std::vector<std::string>& argv) {
         throw UsageError("--seed", "must be a whole number in [0, 2147483647]");
       config.sim.seed_int = static_cast<int>(*seed);
     }
+    if (auto file = a.text("--bench")) {
+      drivers::BenchConfigResult r = drivers::load_bench_config(*file);
+      std::vector<drivers::ProfileError> errors = r.errors;
+      if (r.config) profiles = drivers::load_bench_profiles(*r.config, errors);
+      if (!errors.empty()) {
+        std::string what;
+        for (const auto& e : errors) what += (what.empty() ? "" : "; ") + e.path + ": " + e.reason;
+        throw UsageError("--bench", *file + ": " + what);
+      }
+      bench_config = r.config;
+      if (!bench_config->on_twin())
+        for (const char* flag : {"--config", "--seed", "--udc-V", "--temp-C"})
+          if (a.text(flag))
+            throw UsageError(flag, "configures the in-process twin, which this bench config does not "
+                                   "use; give it to synbench emulate");
+    }
   } catch (const UsageError& e) {
     std::cerr << "synbench point: " << e.what() << "\n";
     return 2;
@@ -129,18 +157,36 @@ int point_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
-  emulator::TwinBench bench(config);
   bench::PointOptions options;
   options.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
-  const auto proc = bench::run_point(bench.devices(), bench.clock(), req, options);
+  std::unique_ptr<emulator::TwinBench> twin_bench;
+  std::unique_ptr<ConfiguredBench> configured;
+  drivers::BenchDevices devices;
+  drivers::Clock* clock = nullptr;
+  if (bench_config) {
+    configured = std::make_unique<ConfiguredBench>(*bench_config, std::move(*profiles), config);
+    devices = configured->bench().devices();
+    clock = &configured->bench().clock();
+    options.tick_s = bench_config->poll_period_ms / 1000.0;
+  } else {
+    twin_bench = std::make_unique<emulator::TwinBench>(config);
+    devices = twin_bench->devices();
+    clock = &twin_bench->clock();
+  }
+  const auto proc = bench::run_point(devices, *clock, req, options);
   if (!proc.has_record()) {
     std::cerr << "synbench point: " << proc.error() << "\n";
+    if (configured) std::cerr << configured->link_errors();
     return 1;
   }
   if (json) {
     std::cout << bench::to_json(proc.record()).dump() << "\n";
+  } else if (configured) {
+    std::cout << "operating point (" << configured->describe() << ", " << clock->now_s()
+              << " s of bench time)\n"
+              << bench::to_text(proc.record());
   } else {
-    std::cout << "operating point (twin, " << bench.clock().now_s() << " s of bench time)\n"
+    std::cout << "operating point (twin, " << clock->now_s() << " s of bench time)\n"
               << bench::to_text(proc.record());
   }
   if (proc.record().fault) {

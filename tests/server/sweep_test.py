@@ -69,7 +69,8 @@ an = json.load(open(an_path))
 check(len(an["curves"]["entries"]) == 4, "analysis: one MTPA/ME curve per (speed, load)")
 
 # --- crash safety: kill -9 at random moments, then resume
-crash = write("crash.json", {"name": "crash", "preset": "thesis-grid",
+# Longer windows for more kills, so the sweep outlasts them (100 kills: the benchmark run).
+crash = write("crash.json", {"name": "crash", "preset": "thesis-grid", "window_s": max(1.0, CRASH_RUNS / 10.0),
                              "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
 CRASH_POINTS = 665
 db = os.path.join(tmp, "crash.db")

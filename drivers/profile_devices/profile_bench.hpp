@@ -1,0 +1,52 @@
+// The bench's devices from three profiles and the buses that reach them: what `synbench point
+// --bench` measures with, on hardware, on `synbench emulate` or on the in-process twin's
+// register server. Its clock is the given one plus the watchdog heartbeats: whenever the bench
+// waits, the heartbeats due meanwhile are sent, so logic never has to remember them.
+#pragma once
+
+#include <memory>
+
+#include "drivers/clock.hpp"
+#include "drivers/devices.hpp"
+#include "drivers/profile_devices/profile_drives.hpp"
+#include "drivers/profile_devices/window_trigger.hpp"
+
+namespace synbench::drivers {
+
+struct ProfileBenchOptions {
+  double window_margin_s = 5.0;  // see ProfileWindowTrigger
+  int retries = 1;               // see SignalIo::set_retries
+};
+
+class ProfileBench {
+ public:
+  ProfileBench(RegisterBus& synrm_bus, DeviceProfile synrm, RegisterBus& load_bus, DeviceProfile load,
+               RegisterBus& meter_bus, DeviceProfile meter, Clock& clock,
+               const ProfileBenchOptions& options = {});
+  ~ProfileBench();
+  ProfileBench(const ProfileBench&) = delete;
+  ProfileBench& operator=(const ProfileBench&) = delete;
+
+  // No truth probe: only the in-process TwinBench can see the plant.
+  BenchDevices devices();
+  // The given clock; waiting on it keeps the heartbeats going.
+  Clock& clock();
+  // Sends the heartbeats due at `now_s`.
+  void tick(double now_s);
+  double next_heartbeat_s() const;
+
+  ProfileSynrmDrive& synrm() { return synrm_; }
+  ProfileLoadDrive& load() { return load_; }
+  ProfileMeter& meter() { return meter_; }
+  ProfileWindowTrigger& trigger() { return trigger_; }
+
+ private:
+  class HeartbeatClock;
+  ProfileSynrmDrive synrm_;
+  ProfileLoadDrive load_;
+  ProfileMeter meter_;
+  ProfileWindowTrigger trigger_;
+  std::unique_ptr<HeartbeatClock> clock_;
+};
+
+}  // namespace synbench::drivers

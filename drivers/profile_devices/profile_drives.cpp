@@ -1,0 +1,166 @@
+// Typed devices over profile signals.
+#include "drivers/profile_devices/profile_drives.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "drivers/error.hpp"
+
+namespace synbench::drivers {
+namespace {
+
+const ProfileSignal* heartbeat_of(const DeviceProfile& p) {
+  for (const ProfileSignal& s : p.signals)
+    if (s.role == SignalRole::heartbeat) return &s;
+  return nullptr;
+}
+
+// NaN (signal absent from the profile) reads as `absent`.
+double or_(double v, double absent = 0.0) { return std::isnan(v) ? absent : v; }
+std::optional<double> opt(double v) { return std::isnan(v) ? std::nullopt : std::optional<double>(v); }
+
+void require_kind(const DeviceProfile& p, DeviceKind kind) {
+  if (p.kind != kind)
+    throw std::invalid_argument("profile '" + p.name + "' is of kind " + std::string(name(p.kind)) +
+                                ", not " + std::string(name(kind)));
+}
+
+}  // namespace
+
+ProfileDevice::ProfileDevice(RegisterBus& bus, DeviceProfile profile)
+    : profile_(std::move(profile)), io_(bus, profile_), heartbeat_(heartbeat_of(profile_)), window_(io_) {}
+
+// --- SynRM drive ---------------------------------------------------------------------------
+
+ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
+    : ProfileDevice(bus, (require_kind(profile, DeviceKind::synrm_drive), std::move(profile))),
+      telemetry_(this->profile(), {"state", "fault_code", "speed_rpm", "im_A", "id_A", "iq_A", "ud_V",
+                                   "uq_V", "udc_V", "pac_W", "temp_C", "voltage_limited"}),
+      window_(this->profile(),
+              {"window_status", "window_sequence", "window_samples", "window_fault_code", "window_s",
+               "window_speed_meas_rpm", "window_im_A", "window_id_A", "window_iq_A", "window_ud_V",
+               "window_uq_V", "window_udc_V", "window_temp_C", "window_voltage_limited_fraction"}),
+      estimator_window_(this->profile(),
+                        {"window_pos_err_min_deg", "window_pos_err_mean_deg", "window_pos_err_max_deg",
+                         "window_speed_err_rpm", "window_ld_est_H", "window_lq_est_H",
+                         "window_rs_est_ohm"}) {}
+
+std::error_code ProfileSynrmDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
+std::error_code ProfileSynrmDrive::set_speed_rpm(double v) { return io().write("speed_setpoint_rpm", v); }
+std::error_code ProfileSynrmDrive::set_angle_deg(double v) { return io().write("angle_setpoint_deg", v); }
+std::error_code ProfileSynrmDrive::reset_fault() { return pulse_fault_reset(); }
+
+std::error_code ProfileSynrmDrive::set_pwm(Pwm pwm) {
+  if (!io().has("pwm_scheme"))
+    return pwm == Pwm::capwm ? std::error_code{} : make_error_code(errc::not_supported);
+  return io().write("pwm_scheme", static_cast<double>(pwm));
+}
+
+std::error_code ProfileSynrmDrive::set_estimator(Estimator estimator) {
+  std::error_code ec;
+  if (!io().has("estimator")) {
+    if (estimator != Estimator::encoder) ec = make_error_code(errc::not_supported);
+  } else {
+    ec = io().write("estimator", static_cast<double>(estimator));
+  }
+  if (!ec) estimator_ = estimator;
+  return ec;
+}
+
+std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
+  double v[12];
+  if (auto ec = io().read(telemetry_, v)) return ec;
+  out.state = static_cast<DriveState>(static_cast<int>(v[0]));
+  out.fault = static_cast<Fault>(static_cast<int>(v[1]));
+  out.speed_rpm = v[2];
+  out.im_A = or_(v[3]);
+  out.id_A = or_(v[4]);
+  out.iq_A = or_(v[5]);
+  out.ud_V = or_(v[6]);
+  out.uq_V = or_(v[7]);
+  out.udc_V = or_(v[8]);
+  out.pac_W = or_(v[9]);
+  out.temp_C = or_(v[10]);
+  out.voltage_limited = or_(v[11]) != 0;
+  return {};
+}
+
+std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
+  double v[14];
+  if (auto ec = window().read_results(window_, v)) return ec;
+  SynrmWindow w;
+  w.samples = static_cast<std::uint32_t>(v[2]);
+  w.fault = static_cast<Fault>(static_cast<int>(or_(v[3])));
+  w.window_s = v[4];
+  w.speed_meas_rpm = or_(v[5]);
+  w.im_A = or_(v[6]);
+  w.id_A = or_(v[7]);
+  w.iq_A = or_(v[8]);
+  w.ud_V = or_(v[9]);
+  w.uq_V = or_(v[10]);
+  w.udc_V = or_(v[11]);
+  w.temp_C = or_(v[12]);
+  w.voltage_limited_fraction = or_(v[13]);
+  if (estimator_ != Estimator::encoder) {
+    // Read after the sequence check: the next window cannot open before this bench starts it.
+    double e[7];
+    if (auto ec = io().read(estimator_window_, e)) return ec;
+    w.pos_err_min_deg = opt(e[0]);
+    w.pos_err_mean_deg = opt(e[1]);
+    w.pos_err_max_deg = opt(e[2]);
+    w.speed_err_rpm = opt(e[3]);
+    w.ld_est_H = opt(e[4]);
+    w.lq_est_H = opt(e[5]);
+    w.rs_est_ohm = opt(e[6]);
+  }
+  out = w;
+  return {};
+}
+
+// --- Load drive ----------------------------------------------------------------------------
+
+ProfileLoadDrive::ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile)
+    : ProfileDevice(bus, (require_kind(profile, DeviceKind::load_drive), std::move(profile))),
+      telemetry_(this->profile(), {"state", "fault_code", "torque_Nm", "iq_A"}),
+      window_(this->profile(), {"window_status", "window_sequence", "window_samples", "window_torque_Nm"}) {}
+
+std::error_code ProfileLoadDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
+std::error_code ProfileLoadDrive::set_torque_Nm(double v) { return io().write("torque_setpoint_Nm", v); }
+std::error_code ProfileLoadDrive::reset_fault() { return pulse_fault_reset(); }
+
+std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
+  double v[4];
+  if (auto ec = io().read(telemetry_, v)) return ec;
+  out.state = static_cast<DriveState>(static_cast<int>(v[0]));
+  out.fault = static_cast<Fault>(static_cast<int>(v[1]));
+  out.torque_Nm = v[2];
+  out.iq_A = or_(v[3]);
+  return {};
+}
+
+std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
+  double v[4];
+  if (auto ec = window().read_results(window_, v)) return ec;
+  out.samples = static_cast<std::uint32_t>(or_(v[2]));
+  out.torque_Nm = or_(v[3]);
+  return {};
+}
+
+// --- VFC meter -----------------------------------------------------------------------------
+
+ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
+    : ProfileDevice(bus, (require_kind(profile, DeviceKind::vfc_meter), std::move(profile))),
+      gate_(this->profile(), {"gate_status", "gate_sequence", "counts_m", "counts_g", "gate_s", "idcm_A", "idcg_A"}) {}
+
+std::error_code ProfileMeter::read(MeterReading& out) {
+  double v[7];
+  if (auto ec = window().read_results(gate_, v)) return ec;
+  out.counts_m = static_cast<std::uint64_t>(or_(v[2]));
+  out.counts_g = static_cast<std::uint64_t>(or_(v[3]));
+  out.gate_s = or_(v[4]);
+  out.idcm_A = or_(v[5]);
+  out.idcg_A = or_(v[6]);
+  return {};
+}
+
+}  // namespace synbench::drivers

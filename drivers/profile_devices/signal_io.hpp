@@ -1,0 +1,84 @@
+// A device's signals by name, through a RegisterBus, as its profile maps them. Reads are
+// planned once (ReadPlan): the signals of one table and unit id that sit next to each other go
+// in one request, so a telemetry read costs a few transactions, not one per signal. Every value
+// is decoded with its limits: a register outside them is errc::protocol, never data.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "drivers/bus/register_bus.hpp"
+#include "drivers/profile/device_profile.hpp"
+
+namespace synbench::drivers {
+
+class ReadPlan {
+ public:
+  // The named signals the profile maps (others are left out: their values stay NaN).
+  ReadPlan(const DeviceProfile& profile, std::initializer_list<std::string_view> names);
+  ReadPlan(const DeviceProfile& profile, std::span<const std::string_view> names);
+
+  std::size_t size() const { return slots_.size(); }
+  std::size_t requests() const { return requests_.size(); }
+  // Whether the profile maps the i-th name.
+  bool present(std::size_t i) const { return slots_[i].signal != nullptr; }
+
+ private:
+  friend class SignalIo;
+  struct Request {
+    std::uint8_t unit_id;
+    RegisterKind kind;
+    std::uint16_t address;
+    std::uint16_t count;
+    std::size_t buffer_offset;  // into the words (or bits) buffer
+  };
+  struct Slot {
+    const ProfileSignal* signal = nullptr;
+    std::size_t request = 0;
+    std::size_t offset = 0;  // of the signal's first word (or bit) in its request
+  };
+  void plan(const DeviceProfile& profile, std::span<const std::string_view> names);
+
+  std::vector<Request> requests_;
+  std::vector<Slot> slots_;
+  std::size_t words_ = 0;  // buffer sizes
+};
+
+class SignalIo {
+ public:
+  SignalIo(RegisterBus& bus, const DeviceProfile& profile) : bus_(bus), profile_(profile) {}
+
+  // How often a request is repeated after a timeout or a malformed reply (after which the bus
+  // has resynchronized, so a repeat cannot pick up the lost reply). Reads and idempotent writes
+  // only: a window start is never repeated (done twice it would not mean the same).
+  void set_retries(int retries) { retries_ = retries; }
+
+  const DeviceProfile& profile() const { return profile_; }
+  RegisterBus& bus() { return bus_; }
+  bool has(std::string_view signal) const { return profile_.find(signal) != nullptr; }
+
+  // Values of the plan's signals in engineering units, in the plan's order: bits as 0 or 1,
+  // enumerated signals as the bench's codes, NaN for signals the profile does not map.
+  // On error `values` is unspecified.
+  std::error_code read(const ReadPlan& plan, std::span<double> values);
+  // Encodes with the signal's limits (errc::invalid_argument outside them) and writes.
+  // errc::not_supported when the profile does not map the signal.
+  std::error_code write(std::string_view signal, double value);
+
+ private:
+  template <class Request>
+  std::error_code with_retries(bool idempotent, Request&& request);
+
+  RegisterBus& bus_;
+  const DeviceProfile& profile_;
+  int retries_ = 0;
+  std::vector<std::uint16_t> words_;
+  std::vector<std::uint8_t> bits_;
+};
+
+}  // namespace synbench::drivers

@@ -1,0 +1,25 @@
+// What stands behind a register map: the values of a device's signals by name, and what a
+// write does. RegisterServer does the Modbus side (tables, encoding, limits, exceptions) from
+// the profiles; a provider only deals in engineering values, so the twin's firmware never sees
+// a register.
+#pragma once
+
+#include <system_error>
+
+#include "drivers/profile/device_profile.hpp"
+
+namespace synbench::emulator {
+
+class SignalProvider {
+ public:
+  virtual ~SignalProvider() = default;
+  // Engineering value of a signal of `device` (enumerated signals as the bench's code, bits as
+  // 0 or 1). Also called for command signals: their last accepted value.
+  virtual double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) = 0;
+  // Applies a write of an engineering value already checked against the signal's limits.
+  // errc::invalid_argument or not_supported (answered ILLEGAL_DATA_VALUE), errc::busy
+  // (SERVER_DEVICE_BUSY), anything else (SERVER_DEVICE_FAILURE).
+  virtual std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) = 0;
+};
+
+}  // namespace synbench::emulator

@@ -1,0 +1,78 @@
+// The firmware side of the twin's register map: what each signal of the default profiles means
+// on the twin's drives and meter, plus what a drive does around its registers: the watchdog
+// (the heartbeat must change within timeout_ms while a drive is enabled, else both drives stop
+// in order and latch fault 6), the fault reset, and the measurement windows with their status
+// and sequence numbers. The three devices share one trigger, as on the thesis bench: the first
+// window start opens the twin's window on all of them, a start on another device while it is
+// open joins it (same length), and each participant's results are published when it closes.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "drivers/devices.hpp"
+#include "drivers/profile/device_profile.hpp"
+#include "emulator/modbus/signal_provider.hpp"
+#include "emulator/twin.hpp"
+
+namespace synbench::emulator {
+
+class TwinSignals final : public SignalProvider {
+ public:
+  // The profiles give the heartbeat timeouts; their signals are served by RegisterServer.
+  TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& profiles);
+
+  double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) override;
+  std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) override;
+
+  // Runs the twin `steps` periods, checking the watchdogs and the window every millisecond.
+  void advance(std::int64_t steps);
+
+  struct WindowState {
+    int status = 0;  // 0 idle, 1 open, 2 done
+    std::uint16_t sequence = 0;
+  };
+  WindowState window(drivers::DeviceKind device) const { return dev_[index(device)].window; }
+  std::uint64_t watchdog_trips() const { return watchdog_trips_; }
+  // Overrides the profiles' heartbeat timeout of both drives (twin time). At a time scale X
+  // the master's scheduling jitter counts X times over; a CI run at 20x may want a longer one.
+  void set_watchdog_timeout_s(double timeout_s) {
+    for (Device& d : dev_)
+      if (d.timeout_s > 0) d.timeout_s = timeout_s;
+  }
+
+ private:
+  struct Device {
+    double heartbeat = 0;
+    double heartbeat_change_s = 0;
+    double timeout_s = 0;  // 0: no watchdog
+    double window_length_ms = 1000;
+    bool in_window = false;
+    WindowState window;
+  };
+  static std::size_t index(drivers::DeviceKind k) { return static_cast<std::size_t>(k); }
+  bool drive_enabled(drivers::DeviceKind k) const;
+  void check_watchdogs();
+  void close_window();
+  std::error_code start_window(drivers::DeviceKind k);
+  double synrm_value(const std::string& name) const;
+  double load_value(const std::string& name) const;
+  double meter_value(const std::string& name) const;
+
+  Twin& twin_;
+  std::array<Device, 3> dev_;
+  std::uint64_t watchdog_trips_ = 0;
+  bool window_active_ = false;
+  double window_active_ms_ = 0;
+  // Commands as last accepted (the firmware keeps some only as ramped references).
+  double speed_set_rpm_ = 0, angle_set_deg_ = 0, torque_set_Nm_ = 0;
+  drivers::Estimator estimator_ = drivers::Estimator::encoder;
+  double f0_Hz_, kf_Hz_per_A_;  // the meter's calibration, used to turn counts into currents
+  // Results of each device's last window.
+  drivers::SynrmWindow synrm_window_;
+  drivers::LoadWindow load_window_;
+  drivers::MeterReading meter_window_;
+};
+
+}  // namespace synbench::emulator

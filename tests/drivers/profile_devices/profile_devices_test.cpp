@@ -1,0 +1,237 @@
+// Tests of the profile devices on an in-memory bus: read planning, decoding with limits and
+// enumerations, refused writes, the heartbeat, and the window protocol's sequence checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drivers/error.hpp"
+#include "drivers/profile_devices/profile_bench.hpp"
+#include "tests/drivers/profile_devices/fake_bus.hpp"
+
+namespace synbench::drivers {
+namespace {
+
+using testing::FakeBus;
+
+DeviceProfile load_default(DeviceKind kind) {
+  ProfileParseResult r = load_device_profile(default_profile_path(kind));
+  if (!r.profile) throw std::runtime_error("default profile does not parse");
+  return *r.profile;
+}
+
+class ManualClock final : public Clock {
+ public:
+  double now_s() const override { return t; }
+  void wait_until(double t_s) override { t = std::max(t, t_s); }
+  double t = 0;
+};
+
+TEST(ReadPlan, AdjacentSignalsShareARequest) {
+  const DeviceProfile p = load_default(DeviceKind::synrm_drive);
+  // state, fault_code: input 0-1; speed..temp: input 16-31; voltage_limited: discrete input 0.
+  ReadPlan plan(p, {"state", "fault_code", "speed_rpm", "im_A", "id_A", "iq_A", "ud_V", "uq_V", "udc_V",
+                    "pac_W", "temp_C", "voltage_limited"});
+  EXPECT_EQ(plan.requests(), 3u);
+  ReadPlan gap(p, {"window_fault_code", "window_s"});  // 104 and 106-107: a gap between
+  EXPECT_EQ(gap.requests(), 2u);
+  ReadPlan missing(p, {"state", "no_such_signal"});
+  EXPECT_TRUE(missing.present(0));
+  EXPECT_FALSE(missing.present(1));
+}
+
+TEST(ProfileSynrmDrive, ReadsTelemetryInThreeRequests) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, load_default(DeviceKind::synrm_drive));
+  const DeviceProfile& p = drive.profile();
+  bus.set(*p.find("state"), 1);
+  bus.set(*p.find("fault_code"), 0);
+  bus.set(*p.find("speed_rpm"), 700.25);
+  bus.set(*p.find("udc_V"), 424.5);
+  bus.set(*p.find("temp_C"), 50.0);
+  bus.set(*p.find("voltage_limited"), 1);
+  SynrmTelemetry t;
+  ASSERT_FALSE(drive.read(t));
+  EXPECT_EQ(bus.log.size(), 3u);
+  EXPECT_EQ(t.state, DriveState::running);
+  EXPECT_DOUBLE_EQ(t.speed_rpm, 700.25);
+  EXPECT_NEAR(t.udc_V, 424.5, 1e-9);
+  EXPECT_NEAR(t.temp_C, 50.0, 1e-9);
+  EXPECT_TRUE(t.voltage_limited);
+}
+
+TEST(ProfileSynrmDrive, AValueOutsideItsLimitsIsAnErrorNotData) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, load_default(DeviceKind::synrm_drive));
+  bus.set(*drive.profile().find("state"), 7);  // limits 0..3
+  SynrmTelemetry t;
+  t.speed_rpm = 123;
+  EXPECT_EQ(drive.read(t), errc::protocol);
+  EXPECT_EQ(t.speed_rpm, 123);  // untouched
+  bus.set(*drive.profile().find("state"), 1);
+  bus.at(1, RegisterKind::input, 16) = 0x7FC0;  // f32 NaN
+  bus.at(1, RegisterKind::input, 17) = 0x0000;
+  EXPECT_EQ(drive.read(t), errc::protocol);
+}
+
+TEST(ProfileSynrmDrive, DeviceCodesAreTranslated) {
+  DeviceProfile p = load_default(DeviceKind::synrm_drive);
+  ProfileSignal& state = const_cast<ProfileSignal&>(*p.find("state"));
+  state.encoding.max = 15;
+  state.values = {{0, "disabled"}, {4, "running"}, {5, "stopping"}, {15, "faulted"}};
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, p);
+  bus.set(*drive.profile().find("state"), 4);
+  SynrmTelemetry t;
+  ASSERT_FALSE(drive.read(t));
+  EXPECT_EQ(t.state, DriveState::running);
+  bus.set(*drive.profile().find("state"), 1);  // not one of this drive's numbers
+  EXPECT_EQ(drive.read(t), errc::protocol);
+}
+
+TEST(ProfileSynrmDrive, WritesOutsideTheLimitsNeverReachTheWire) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, load_default(DeviceKind::synrm_drive));
+  EXPECT_EQ(drive.set_speed_rpm(4000), errc::invalid_argument);
+  EXPECT_EQ(drive.set_angle_deg(std::nan("")), errc::invalid_argument);
+  EXPECT_TRUE(bus.log.empty());
+  EXPECT_FALSE(drive.set_angle_deg(52.5));
+  EXPECT_EQ(bus.at(1, RegisterKind::holding, 18), 5250);
+}
+
+TEST(ProfileSynrmDrive, ModesAbsentFromTheProfileAcceptOnlyTheDefault) {
+  DeviceProfile p = load_default(DeviceKind::synrm_drive);
+  std::erase_if(p.signals, [](const ProfileSignal& s) { return s.name == "estimator" || s.name == "pwm_scheme"; });
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, p);
+  EXPECT_FALSE(drive.set_estimator(Estimator::encoder));
+  EXPECT_FALSE(drive.set_pwm(Pwm::capwm));
+  EXPECT_EQ(drive.set_estimator(Estimator::hfi), errc::not_supported);
+  EXPECT_EQ(drive.set_pwm(Pwm::aspwm), errc::not_supported);
+}
+
+TEST(Heartbeat, NewValueEveryPeriodAndRetriedSoonAfterAFailure) {
+  FakeBus bus;
+  ProfileLoadDrive drive(bus, load_default(DeviceKind::load_drive));
+  drive.tick(0.0);
+  EXPECT_EQ(bus.at(2, RegisterKind::holding, 0), 1);
+  drive.tick(0.05);  // not due: period 100 ms
+  EXPECT_EQ(bus.log.size(), 1u);
+  drive.tick(0.1);
+  EXPECT_EQ(bus.at(2, RegisterKind::holding, 0), 2);
+  bus.fail_next = make_error_code(errc::timeout);
+  EXPECT_EQ(drive.tick(0.2), errc::timeout);
+  EXPECT_DOUBLE_EQ(drive.next_heartbeat_s(), 0.225);
+  EXPECT_FALSE(drive.tick(0.225));
+  EXPECT_EQ(bus.at(2, RegisterKind::holding, 0), 3);
+  EXPECT_EQ(drive.heartbeat_failures(), 1u);
+}
+
+struct WindowFixture : ::testing::Test {
+  FakeBus bus;
+  ManualClock clock;
+  ProfileBench bench{bus, load_default(DeviceKind::synrm_drive), bus, load_default(DeviceKind::load_drive),
+                     bus, load_default(DeviceKind::vfc_meter), clock};
+  // Status and sequence of every device (input 100, 101 at units 1..3).
+  void set_window(std::uint16_t status, std::uint16_t sequence) {
+    for (std::uint8_t u = 1; u <= 3; ++u) {
+      bus.at(u, RegisterKind::input, 100) = status;
+      bus.at(u, RegisterKind::input, 101) = sequence;
+    }
+  }
+};
+
+TEST_F(WindowFixture, LengthsFirstThenTheStartCoilsBackToBack) {
+  set_window(2, 5);
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  std::vector<std::string> writes;
+  for (const auto& r : bus.log)
+    if (r.op == "write") writes.push_back(std::to_string(r.unit_id) + (r.kind == RegisterKind::coil ? "c" : "h") + std::to_string(r.address));
+  EXPECT_EQ(writes, (std::vector<std::string>{"1h2", "2h2", "3h2", "1c2", "2c2", "3c2"}));
+  EXPECT_EQ(bus.at(1, RegisterKind::holding, 3), 1000);  // u32 ms, low word
+}
+
+TEST_F(WindowFixture, ResultsOfAnEarlierWindowAreNeverTaken) {
+  SynrmWindow w;
+  EXPECT_EQ(bench.synrm().read_window(w), errc::not_ready);  // no window started by this bench
+  set_window(2, 5);  // an earlier window's results are on the device
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  EXPECT_FALSE(bench.trigger().window_closed());
+  EXPECT_EQ(bench.synrm().read_window(w), errc::not_ready);  // done, but still sequence 5
+  set_window(1, 5);
+  EXPECT_FALSE(bench.trigger().window_closed());
+  const DeviceProfile& p = bench.synrm().profile();
+  bus.set(*p.find("window_samples"), 10000);
+  bus.set(*p.find("window_s"), 1.0);
+  bus.set(*p.find("window_im_A"), 1.905);
+  set_window(2, 6);
+  EXPECT_TRUE(bench.trigger().window_closed());
+  ASSERT_FALSE(bench.synrm().read_window(w));
+  EXPECT_EQ(w.samples, 10000u);
+  EXPECT_NEAR(w.im_A, 1.905, 1e-6);
+  EXPECT_FALSE(w.pos_err_mean_deg);  // encoder: estimator results not read
+}
+
+TEST_F(WindowFixture, ASequenceMovingDuringTheReadIsNotReady) {
+  set_window(2, 5);
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  set_window(2, 6);
+  ASSERT_TRUE(bench.trigger().window_closed());
+  // Another window closes between the results and the check of the sequence.
+  bus.before = [&](const FakeBus::Request& r) {
+    if (r.unit_id == 2 && r.address == 100 && r.count == 2) set_window(2, 7);
+  };
+  LoadWindow lw;
+  EXPECT_EQ(bench.load().read_window(lw), errc::not_ready);
+}
+
+TEST_F(WindowFixture, AWindowThatNeverClosesReadsAsTimeout) {
+  set_window(2, 5);
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  set_window(1, 5);
+  clock.t = 1.0 + 5.0 + 0.1;  // past the window and its margin
+  EXPECT_TRUE(bench.trigger().window_closed());
+  MeterReading m;
+  EXPECT_EQ(bench.meter().read(m), errc::timeout);
+}
+
+TEST_F(WindowFixture, AnOpenWindowIsBusy) {
+  set_window(1, 5);
+  EXPECT_EQ(bench.trigger().open_window(1.0), errc::busy);
+}
+
+TEST_F(WindowFixture, ATimedOutReadIsRepeatedOnceAWindowStartNever) {
+  bus.at(1, RegisterKind::input, 0) = 1;  // running
+  bus.fail_next = make_error_code(errc::timeout);
+  SynrmTelemetry t;
+  ASSERT_FALSE(bench.synrm().read(t));
+  EXPECT_EQ(t.state, DriveState::running);
+  EXPECT_EQ(bus.log.size(), 4u);  // three requests, the first one twice
+  bus.fail_next = make_error_code(errc::exception_reply);  // a refusal is an answer: no repeat
+  EXPECT_EQ(bench.synrm().read(t), errc::exception_reply);
+  set_window(2, 5);
+  bus.before = [&](const FakeBus::Request& r) {
+    if (r.op == "write" && r.kind == RegisterKind::coil && r.address == 2) bus.fail_next = make_error_code(errc::timeout);
+  };
+  EXPECT_EQ(bench.trigger().open_window(1.0), errc::timeout);
+  int starts = 0;
+  for (const auto& r : bus.log) starts += r.op == "write" && r.kind == RegisterKind::coil && r.address == 2;
+  EXPECT_EQ(starts, 1);
+}
+
+TEST_F(WindowFixture, TheClockSendsHeartbeatsWhileTheBenchWaits) {
+  bench.clock().wait_until(1.0);
+  // 0, 0.1, ..., 1.0: ten or eleven heartbeats to each drive (the last one falls within
+  // rounding of the end), none to the meter (it has none).
+  int drive1 = 0, drive2 = 0, meter = 0;
+  for (const auto& r : bus.log) {
+    if (r.op != "write") continue;
+    (r.unit_id == 1 ? drive1 : r.unit_id == 2 ? drive2 : meter)++;
+  }
+  EXPECT_GE(drive1, 10);
+  EXPECT_LE(drive1, 11);
+  EXPECT_EQ(drive2, drive1);
+  EXPECT_EQ(meter, 0);
+}
+
+}  // namespace
+}  // namespace synbench::drivers
