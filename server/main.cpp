@@ -18,6 +18,8 @@ commands:
   sweep     run a sweep plan on the twin, stored in SQLite, resumable
   config    print or check the twin's configuration
   emulate   serve the twin over Modbus TCP or RTU
+  serve     run the daemon: REST API over the twin in real time (docs/api.md)
+  token     create a bearer token for the daemon
 
   synbench <command> --help    options of a command
   synbench --version           version
@@ -41,6 +43,8 @@ int main(int argc, char** argv) {
   if (command == "config") return synbench::cli::config_command(args);
   if (command == "sweep") return synbench::cli::sweep_command(args);
   if (command == "emulate") return synbench::cli::emulate_command(args);
+  if (command == "serve") return synbench::cli::serve_command(args);
+  if (command == "token") return synbench::cli::token_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

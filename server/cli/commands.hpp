@@ -11,10 +11,14 @@ int point_command(const std::vector<std::string>& args);
 int config_command(const std::vector<std::string>& args);
 int sweep_command(const std::vector<std::string>& args);
 int emulate_command(const std::vector<std::string>& args);
+int serve_command(const std::vector<std::string>& args);
+int token_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
 extern const char* const kSweepHelp;
 extern const char* const kEmulateHelp;
+extern const char* const kServeHelp;
+extern const char* const kTokenHelp;
 
 }  // namespace synbench::cli

@@ -1,0 +1,273 @@
+// Route handlers of the daemon; see api_routes.hpp and docs/api.md.
+#include "server/http/api_routes.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <sstream>
+
+namespace synbench::http {
+
+void HttpMetrics::count(int status) {
+  std::lock_guard lock(mutex_);
+  ++by_status_[status];
+}
+
+std::map<int, std::uint64_t> HttpMetrics::by_status() const {
+  std::lock_guard lock(mutex_);
+  return by_status_;
+}
+
+std::variant<nlohmann::json, Response> parse_json_object(const std::string& body) {
+  if (body.empty()) return error_response(400, "bad_json", "the request needs a JSON object body");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(body);
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.what() names the position: "parse error at line 1, column 9: syntax error ..."
+    std::string what = e.what();
+    const auto bracket = what.find("] ");
+    if (bracket != std::string::npos) what = what.substr(bracket + 2);
+    return error_response(400, "bad_json", "the body is not JSON: " + what);
+  }
+  if (!doc.is_object()) return error_response(400, "bad_json", "the body must be a JSON object");
+  return doc;
+}
+
+namespace {
+
+const char* phase_name(bench::SafetyPhase p) {
+  switch (p) {
+    case bench::SafetyPhase::normal: return "normal";
+    case bench::SafetyPhase::stopping_load: return "stopping_load";
+    case bench::SafetyPhase::stopping_speed: return "stopping_speed";
+    case bench::SafetyPhase::stopped: return "stopped";
+    case bench::SafetyPhase::estopped: return "estopped";
+  }
+  return "?";
+}
+
+const char* state_name(drivers::DriveState s) {
+  switch (s) {
+    case drivers::DriveState::disabled: return "disabled";
+    case drivers::DriveState::running: return "running";
+    case drivers::DriveState::stopping: return "stopping";
+    case drivers::DriveState::faulted: return "faulted";
+  }
+  return "?";
+}
+
+Response bad_field(const std::string& field, const std::string& reason) {
+  return error_response(400, "bad_field", field + ": " + reason);
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+Response refusal_or_ok(const std::optional<Refusal>& r, BenchRuntime& bench) {
+  if (r) return error_response(r->status, r->code, r->message);
+  return json_response(200, status_json(bench.status()));
+}
+
+// Rejects fields other than `known`, so a typo ("speed") is an error instead of a no-op.
+std::optional<Response> unknown_fields(const nlohmann::json& doc, const std::set<std::string>& known) {
+  for (const auto& [k, v] : doc.items())
+    if (!known.count(k)) {
+      std::string list;
+      for (const auto& n : known) list += (list.empty() ? "" : ", ") + n;
+      return bad_field(k, "unknown field (expected: " + list + ")");
+    }
+  return std::nullopt;
+}
+
+nlohmann::json number_schema(double min, double max, const std::string& desc) {
+  return {{"type", "number"}, {"minimum", min}, {"maximum", max}, {"description", desc}};
+}
+
+}  // namespace
+
+Response locked(const ControlLock& lock) {
+  const auto d = lock.describe();
+  return error_response(409, "locked",
+                        "the control lock is held by " + d.value("holder", std::string("another operator")) +
+                            " (it expires after " + std::to_string(ControlLock::kIdle.count()) +
+                            " s idle; E-stop is always allowed)");
+}
+
+nlohmann::json status_json(const BenchStatus& s) {
+  nlohmann::json j;
+  j["t_s"] = s.t_s;
+  j["enabled"] = s.enabled;
+  j["stopping"] = s.stopping;
+  j["setpoints"] = {{"speed_rpm", s.setpoints.speed_rpm}, {"load_Nm", s.setpoints.load_Nm}, {"angle_deg", s.setpoints.angle_deg}};
+  if (s.synrm) {
+    const auto& t = *s.synrm;
+    j["synrm"] = {{"speed_rpm", t.speed_rpm}, {"im_A", t.im_A},     {"id_A", t.id_A},     {"iq_A", t.iq_A},
+                  {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
+                  {"temp_C", t.temp_C},       {"voltage_limited", t.voltage_limited},
+                  {"state", state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
+  } else {
+    j["synrm"] = nullptr;
+  }
+  if (s.load) {
+    const auto& t = *s.load;
+    j["load"] = {{"torque_Nm", t.torque_Nm}, {"iq_A", t.iq_A}, {"state", state_name(t.state)},
+                 {"fault", std::string(drivers::fault_name(t.fault))}};
+  } else {
+    j["load"] = nullptr;
+  }
+  j["supervisor"] = {{"phase", phase_name(s.phase)}, {"tripped", s.trip.has_value()}};
+  if (s.trip)
+    j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))}, {"detail", s.trip->detail}, {"at_s", s.trip->at_s}};
+  j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
+  if (s.sweep)
+    j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
+                  {"error", s.sweep->error}};
+  else
+    j["sweep"] = nullptr;
+  nlohmann::json ev = nlohmann::json::array();
+  for (const auto& e : s.events) ev.push_back({{"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
+  j["events"] = ev;
+  return j;
+}
+
+std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status) {
+  std::ostringstream o;
+  auto gauge = [&](const char* name, const char* help, double v) {
+    o << "# HELP " << name << " " << help << "\n# TYPE " << name << " gauge\n" << name << " " << v << "\n";
+  };
+  gauge("synbench_bench_time_seconds", "Bench (twin) time since the daemon started.", s.t_s);
+  gauge("synbench_bench_enabled", "1 while the drives are enabled by an operator.", s.enabled ? 1 : 0);
+  gauge("synbench_supervisor_tripped", "1 while the safety supervisor's trip is latched.", s.trip ? 1 : 0);
+  if (s.synrm) {
+    gauge("synbench_synrm_speed_rpm", "SynRM speed.", s.synrm->speed_rpm);
+    gauge("synbench_synrm_current_A", "SynRM current magnitude.", s.synrm->im_A);
+    gauge("synbench_synrm_udc_V", "DC-bus voltage at the SynRM drive.", s.synrm->udc_V);
+    gauge("synbench_synrm_temp_C", "SynRM winding temperature.", s.synrm->temp_C);
+    gauge("synbench_synrm_pac_W", "SynRM drive output power estimate.", s.synrm->pac_W);
+  }
+  if (s.load) gauge("synbench_load_torque_Nm", "Braking torque of the load machine.", s.load->torque_Nm);
+  o << "# HELP synbench_loop_ticks_total Bench loop ticks.\n# TYPE synbench_loop_ticks_total counter\n"
+    << "synbench_loop_ticks_total " << s.ticks << "\n";
+  o << "# HELP synbench_loop_overruns_total Bench loop ticks that started late.\n# TYPE synbench_loop_overruns_total counter\n"
+    << "synbench_loop_overruns_total " << s.overruns << "\n";
+  o << "# HELP synbench_http_requests_total HTTP requests answered, by status.\n# TYPE synbench_http_requests_total counter\n";
+  for (const auto& [code, n] : http_by_status) o << "synbench_http_requests_total{status=\"" << code << "\"} " << n << "\n";
+  return o.str();
+}
+
+void add_api_routes(Router& router, ApiContext ctx) {
+  BenchRuntime* bench = &ctx.bench;
+  HttpMetrics* metrics = &ctx.metrics;
+  const Router* self = &router;
+  const std::string version = ctx.version;
+  const double max_speed_rpm = bench->config().firmware.max_speed_rpm;
+  ControlLock* control = &ctx.control;
+  constexpr double kMaxLoad_Nm = 10.0;  // beyond the 0.55 kW machine's rating; the supervisor guards current
+
+  router.add({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
+              [bench, version](const Request&) {
+                const auto s = bench->status();
+                return json_response(200, {{"status", "ok"}, {"version", version}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
+              }});
+  router.add({"GET", "/api/openapi.json", Role::anyone, "This API as an OpenAPI 3 document.",
+              [self, version](const Request&) { return json_response(200, self->openapi("synbench", version)); }});
+  router.add({"GET", "/metrics", Role::anyone, "Prometheus metrics (text format 0.0.4): bench telemetry and HTTP counts.",
+              [bench, metrics](const Request&) {
+                Response r;
+                r.content_type = "text/plain; version=0.0.4";
+                r.body = prometheus_text(bench->status(), metrics->by_status());
+                return r;
+              }});
+  router.add({"GET", "/api/bench/status", Role::viewer,
+              "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
+              [bench](const Request&) { return json_response(200, status_json(bench->status())); }});
+  router.add({"GET", "/api/bench/config", Role::viewer, "Limits the bench's setpoints are validated against.",
+              [max_speed_rpm, kMaxLoad_Nm](const Request&) {
+                return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},
+                                           {"load_Nm", {{"min", 0}, {"max", kMaxLoad_Nm}}},
+                                           {"angle_deg", {{"min_exclusive", 0}, {"max_exclusive", 90}}},
+                                           {"tick_ms", BenchRuntime::kTick.count()}});
+              }});
+  router.add({"GET", "/api/bench/lock", Role::viewer, "Who holds the operators' control lock.",
+              [control](const Request&) { return json_response(200, control->describe()); }});
+  router.add({"POST", "/api/bench/lock", Role::operator_,
+              "Claim the control lock (operator commands claim it too); 409 while another operator holds it.",
+              [control](const Request& req) {
+                if (!control->claim(req.caller_id)) return locked(*control);
+                return json_response(200, control->describe());
+              }});
+  router.add({"DELETE", "/api/bench/lock", Role::operator_, "Release the control lock; 409 when another operator holds it.",
+              [control](const Request& req) {
+                if (!control->release(req.caller_id)) return locked(*control);
+                return json_response(200, control->describe());
+              }});
+  router.add({"POST", "/api/bench/estop", Role::operator_, "E-stop: both drives disabled at once; latched until reset.",
+              [bench](const Request&) {
+                bench->estop();
+                return json_response(200, status_json(bench->status()));
+              }});
+  router.add({"POST", "/api/bench/reset", Role::operator_,
+              "Clear the supervisor's latched trip and the drives' faults (refused during an ordered stop).",
+              [bench, control](const Request& req) {
+                if (!control->claim(req.caller_id)) return locked(*control);
+                return refusal_or_ok(bench->reset(), *bench);
+              }});
+  router.add({"POST", "/api/bench/enable", Role::operator_,
+              "Enable both drives with the current setpoints, or disable them by the ordered stop.",
+              [bench, control](const Request& req) {
+                if (!control->claim(req.caller_id)) return locked(*control);
+                auto parsed = parse_json_object(req.body);
+                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                const auto& doc = std::get<nlohmann::json>(parsed);
+                if (auto r = unknown_fields(doc, {"enabled"})) return *r;
+                if (!doc.contains("enabled")) return bad_field("enabled", "required");
+                if (!doc["enabled"].is_boolean()) return bad_field("enabled", "must be true or false");
+                return refusal_or_ok(bench->enable(doc["enabled"].get<bool>()), *bench);
+              },
+              nlohmann::json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
+  router.add({"POST", "/api/bench/setpoints", Role::operator_,
+              "Set speed_rpm, load_Nm and/or angle_deg (omitted fields keep their value).",
+              [bench, control, max_speed_rpm, kMaxLoad_Nm](const Request& req) {
+                if (!control->claim(req.caller_id)) return locked(*control);
+                auto parsed = parse_json_object(req.body);
+                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                const auto& doc = std::get<nlohmann::json>(parsed);
+                if (auto r = unknown_fields(doc, {"speed_rpm", "load_Nm", "angle_deg"})) return *r;
+                if (doc.empty()) return error_response(400, "bad_field", "give at least one of speed_rpm, load_Nm, angle_deg");
+                Setpoints sp = bench->status().setpoints;
+                struct Field {
+                  const char* name;
+                  double* value;
+                  double lo, hi;
+                  bool open;  // exclusive bounds
+                };
+                const Field fields[] = {{"speed_rpm", &sp.speed_rpm, 0, max_speed_rpm, false},
+                                        {"load_Nm", &sp.load_Nm, 0, kMaxLoad_Nm, false},
+                                        {"angle_deg", &sp.angle_deg, 0, 90, true}};
+                for (const Field& f : fields) {
+                  if (!doc.contains(f.name)) continue;
+                  const auto& v = doc[f.name];
+                  if (!v.is_number()) return bad_field(f.name, "must be a number");
+                  const double x = v.get<double>();
+                  const bool ok = std::isfinite(x) && (f.open ? (x > f.lo && x < f.hi) : (x >= f.lo && x <= f.hi));
+                  if (!ok)
+                    return bad_field(f.name, fmt(x) + " is outside " + (f.open ? "(" : "[") + fmt(f.lo) + ", " + fmt(f.hi) +
+                                                 (f.open ? ")" : "]"));
+                  *f.value = x;
+                }
+                return refusal_or_ok(bench->set_setpoints(sp), *bench);
+              },
+              nlohmann::json{{"type", "object"},
+                             {"additionalProperties", false},
+                             {"properties",
+                              {{"speed_rpm", number_schema(0, max_speed_rpm, "SynRM speed setpoint")},
+                               {"load_Nm", number_schema(0, kMaxLoad_Nm, "braking torque of the load")},
+                               {"angle_deg", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 90}, {"exclusiveMaximum", true}, {"description", "current angle"}}}}}}});
+}
+
+}  // namespace synbench::http

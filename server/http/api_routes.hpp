@@ -1,0 +1,89 @@
+// The daemon's REST routes: the table that Router dispatches and the OpenAPI document lists.
+// Each handler validates its input (400 naming the field), calls the bench runtime, and shapes
+// the JSON answer; docs/api.md describes every route.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <variant>
+
+#include "server/http/bench_runtime.hpp"
+#include "server/http/router.hpp"
+
+namespace synbench::http {
+
+// Request counts by status, for /metrics.
+class HttpMetrics {
+ public:
+  void count(int status);
+  std::map<int, std::uint64_t> by_status() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<int, std::uint64_t> by_status_;
+};
+
+// One operator commands the bench at a time. The first operator command claims the lock; another
+// operator's commands are refused (409) until the holder releases it or has been idle for
+// kIdle, so a vanished client cannot lock the bench out for good. E-stop never needs it.
+class ControlLock {
+ public:
+  static constexpr std::chrono::seconds kIdle{600};
+  using Clock = std::chrono::steady_clock;
+
+  // True when `id` holds the lock now (claimed or renewed).
+  bool claim(const std::string& id) {
+    std::lock_guard lock(mutex_);
+    const auto now = Clock::now();
+    if (holder_.empty() || holder_ == id || now - last_ > kIdle) holder_ = id;
+    if (holder_ != id) return false;
+    last_ = now;
+    return true;
+  }
+  // False when another operator holds it.
+  bool release(const std::string& id) {
+    std::lock_guard lock(mutex_);
+    if (holder_.empty() || holder_ == id || Clock::now() - last_ > kIdle) {
+      holder_.clear();
+      return true;
+    }
+    return false;
+  }
+  nlohmann::json describe() const {
+    std::lock_guard lock(mutex_);
+    const auto idle_s = std::chrono::duration<double>(Clock::now() - last_).count();
+    if (holder_.empty() || idle_s > static_cast<double>(kIdle.count())) return {{"holder", nullptr}};
+    return {{"holder", holder_}, {"idle_s", idle_s}, {"expires_in_s", static_cast<double>(kIdle.count()) - idle_s}};
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::string holder_;
+  Clock::time_point last_{};
+};
+
+// 409 `locked`, naming the holder.
+Response locked(const ControlLock& lock);
+
+struct ApiContext {
+  BenchRuntime& bench;
+  ControlLock& control;
+  HttpMetrics& metrics;
+  std::string version;
+};
+
+// Adds every route to `router`; the OpenAPI route reads `router` itself when called.
+void add_api_routes(Router& router, ApiContext ctx);
+
+// Request parsing helpers shared by handlers; exposed for tests.
+// The body as a JSON object, or a 400 response naming the problem.
+std::variant<nlohmann::json, Response> parse_json_object(const std::string& body);
+
+nlohmann::json status_json(const BenchStatus& s);
+std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status);
+
+}  // namespace synbench::http

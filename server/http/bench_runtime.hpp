@@ -1,0 +1,132 @@
+// The daemon's bench: the in-process twin run in real time on a thread of its own. Every 10 ms
+// the twin's virtual clock is advanced to the wall clock's elapsed time and the safety
+// supervisor ticked; HTTP handlers reach the bench only through this class, whose mutex they
+// share with the bench thread for the few microseconds a command or a status read takes.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <filesystem>
+#include <map>
+
+#include "bench/safety_supervisor.hpp"
+#include "bench/sweep_engine.hpp"
+#include "db/store.hpp"
+#include "emulator/twin_bench.hpp"
+#include "emulator/twin_config.hpp"
+
+namespace synbench::http {
+
+struct Setpoints {
+  double speed_rpm = 0;
+  double load_Nm = 0;
+  double angle_deg = 45;
+};
+
+struct BenchEvent {
+  double t_s = 0;
+  std::string kind, message;
+};
+
+// The sweep the bench thread runs (or ran last).
+struct SweepRun {
+  std::int64_t id = 0;
+  std::string state;  // bench::SweepState's name
+  std::size_t done = 0, total = 0;
+  std::string error;
+};
+
+struct BenchStatus {
+  double t_s = 0;  // bench time since start
+  bool enabled = false;
+  bool stopping = false;  // an ordered stop asked for by disable or shutdown is under way
+  Setpoints setpoints;
+  std::optional<drivers::SynrmTelemetry> synrm;
+  std::optional<drivers::LoadTelemetry> load;
+  bench::SafetyPhase phase = bench::SafetyPhase::normal;
+  std::optional<bench::SafetyTrip> trip;
+  std::uint64_t ticks = 0;
+  std::uint64_t overruns = 0;  // ticks that started more than one period late
+  std::deque<BenchEvent> events;  // the most recent supervisor and command events
+  std::optional<SweepRun> sweep;
+};
+
+// Why a command was refused: an HTTP status, a stable code and a sentence.
+struct Refusal {
+  int status = 409;
+  std::string code, message;
+};
+
+class BenchRuntime {
+ public:
+  static constexpr std::chrono::milliseconds kTick{10};
+  static constexpr std::size_t kMaxEvents = 50;
+
+  BenchRuntime(const emulator::TwinConfig& config, bench::SafetyLimits limits);
+  ~BenchRuntime();
+  BenchRuntime(const BenchRuntime&) = delete;
+  BenchRuntime& operator=(const BenchRuntime&) = delete;
+
+  void start();
+  // The ordered stop (load torque to zero, speed to zero, drives disabled), waiting up to
+  // `timeout` of wall time for it, then the bench thread ends. Idempotent.
+  void shutdown(std::chrono::milliseconds timeout = std::chrono::milliseconds(15000));
+
+  BenchStatus status() const;
+  const emulator::TwinConfig& config() const { return config_; }
+
+  // Enabling starts both drives with the current setpoints; disabling is the ordered stop.
+  std::optional<Refusal> enable(bool on);
+  // Applied at once when enabled, kept for the next enable otherwise. Values are validated by
+  // the caller (the REST handler names the field); refused while the supervisor is tripped.
+  std::optional<Refusal> set_setpoints(const Setpoints& sp);
+  void estop();
+  std::optional<Refusal> reset();
+
+  // Runs sweep `id` of the store at `db_path` on the bench thread (its own connection there),
+  // skipping `stored` points; refused while the bench is enabled by hand, tripped or busy.
+  std::optional<Refusal> start_sweep(std::int64_t id, bench::SweepPlan plan,
+                                     std::map<std::size_t, bench::PointRecord> stored, const std::filesystem::path& db_path);
+  // "pause", "resume" or "abort" of the running sweep `id`.
+  std::optional<Refusal> sweep_action(std::int64_t id, const std::string& action);
+
+ private:
+  class Sink;
+  void finish_sweep_locked();
+  void run();
+  void tick_locked(double now_s);
+  void event_locked(const std::string& kind, const std::string& message);
+  std::optional<Refusal> apply_locked();
+
+  emulator::TwinConfig config_;
+  std::unique_ptr<emulator::TwinBench> twin_;
+  std::unique_ptr<bench::SafetySupervisor> supervisor_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool quit_ = false;
+  bool enabled_ = false;
+  bool stopping_ = false;
+  double stop_since_s_ = 0;
+  Setpoints setpoints_;
+  std::uint64_t ticks_ = 0, overruns_ = 0;
+  std::deque<BenchEvent> events_;
+  std::unique_ptr<db::Store> sweep_store_;
+  std::unique_ptr<Sink> sink_;
+  std::unique_ptr<bench::SweepEngine> engine_;
+  std::int64_t sweep_id_ = 0;
+  bool sweep_sparse_ = false;
+  std::optional<SweepRun> last_sweep_;
+  std::thread thread_;
+  bool shut_down_ = false;
+};
+
+}  // namespace synbench::http

@@ -1,0 +1,245 @@
+// Listener and sessions; see http_server.hpp.
+#include "server/http/http_server.hpp"
+
+#include <array>
+#include <chrono>
+#include <iostream>
+
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+
+namespace synbench::http {
+
+namespace beast = boost::beast;
+namespace bhttp = boost::beast::http;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+
+std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_t port) {
+  const std::string p = ":" + std::to_string(port);
+  std::set<std::string> out;
+  const bool v6 = listen_host.find(':') != std::string::npos;
+  out.insert((v6 ? "[" + listen_host + "]" : listen_host) + p);
+  boost::system::error_code ec;
+  const auto addr = net::ip::make_address(listen_host, ec);
+  if (listen_host == "localhost" || (!ec && addr.is_loopback()))
+    for (const char* h : {"localhost", "127.0.0.1", "[::1]"}) out.insert(std::string(h) + p);
+  return out;
+}
+
+struct HttpServer::Shared {
+  Shared(const Router& r, ServerLimits l, Observer o) : router(r), limits(l), observer(std::move(o)) {}
+  const Router& router;
+  ServerLimits limits;
+  Observer observer;
+  std::set<std::string> hosts;
+  std::atomic<bool> closing{false};
+  std::atomic<std::size_t> connections{0};
+};
+
+namespace {
+
+void fail(beast::error_code ec, const char* what) {
+  // Ordinary ends of a connection are not worth a line.
+  if (ec == net::error::operation_aborted || ec == bhttp::error::end_of_stream || ec == beast::error::timeout ||
+      ec == net::error::eof || ec == net::error::connection_reset)
+    return;
+  std::cerr << "synbench serve: " << what << ": " << ec.message() << "\n";
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(tcp::socket&& socket, std::shared_ptr<HttpServer::Shared> shared)
+      : stream_(std::move(socket)), shared_(std::move(shared)) {
+    ++shared_->connections;
+  }
+  ~Session() { --shared_->connections; }
+
+  void run() {
+    net::dispatch(stream_.get_executor(), beast::bind_front_handler(&Session::do_read, shared_from_this()));
+  }
+
+  // Over the connection limit: one 503 and close, without reading a request.
+  void refuse() {
+    net::dispatch(stream_.get_executor(), [self = shared_from_this()] {
+      self->send_error(503, "too_many_connections",
+                       "more than " + std::to_string(self->shared_->limits.max_connections) + " open connections", false);
+    });
+  }
+
+ private:
+  void do_read() {
+    parser_.emplace();
+    parser_->body_limit(shared_->limits.max_body_bytes);
+    parser_->header_limit(static_cast<std::uint32_t>(shared_->limits.max_header_bytes));
+    stream_.expires_after(std::chrono::milliseconds(static_cast<long>(shared_->limits.read_timeout_s * 1000)));
+    bhttp::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&Session::on_read, shared_from_this()));
+  }
+
+  void on_read(beast::error_code ec, std::size_t) {
+    if (ec == bhttp::error::body_limit) {
+      return send_error(413, "body_too_large", "the body exceeds " + std::to_string(shared_->limits.max_body_bytes) + " bytes", false);
+    }
+    if (ec == bhttp::error::header_limit) {
+      return send_error(431, "header_too_large", "the header exceeds " + std::to_string(shared_->limits.max_header_bytes) + " bytes", false);
+    }
+    if (ec == bhttp::error::end_of_stream || ec == beast::error::timeout) return do_close();
+    if (ec) {
+      // A malformed request gets an answer when the peer is still there to read it.
+      if (ec.category() == bhttp::make_error_code(bhttp::error::bad_target).category())
+        return send_error(400, "bad_request", "malformed HTTP request: " + ec.message(), false);
+      return fail(ec, "read");
+    }
+    handle(parser_->release());
+  }
+
+  void handle(bhttp::request<bhttp::string_body> req) {
+    const bool keep_alive = req.keep_alive() && !shared_->closing;
+    const std::string host(req[bhttp::field::host]);
+    const std::string method(req.method_string());
+    const std::string target(req.target());
+    Response r;
+    if (!shared_->hosts.count(lower(host))) {
+      r = error_response(403, "host_not_allowed", "the Host header must name the listen address");
+    } else {
+      const auto auth = req[bhttp::field::authorization];
+      r = shared_->router.dispatch(method, target, std::string_view(auth.data(), auth.size()), std::move(req.body()));
+    }
+    if (shared_->observer) shared_->observer(method, target.substr(0, target.find('?')), r.status);
+    auto res = std::make_shared<bhttp::response<bhttp::string_body>>(static_cast<bhttp::status>(r.status), req.version());
+    res->set(bhttp::field::server, "synbench");
+    res->set(bhttp::field::content_type, r.content_type);
+    res->set(bhttp::field::cache_control, "no-store");
+    res->set("X-Content-Type-Options", "nosniff");
+    for (const auto& [k, v] : r.headers) res->set(k, v);
+    res->keep_alive(keep_alive);
+    res->body() = std::move(r.body);
+    res->prepare_payload();
+    if (req.method() == bhttp::verb::head) res->body().clear();  // Content-Length stays that of GET
+    write(res);
+  }
+
+  void send_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
+    draining_ = !keep_alive;
+    Response r = error_response(status, code, message);
+    if (shared_->observer) shared_->observer("?", "?", status);
+    auto res = std::make_shared<bhttp::response<bhttp::string_body>>(static_cast<bhttp::status>(status), 11);
+    res->set(bhttp::field::server, "synbench");
+    res->set(bhttp::field::content_type, r.content_type);
+    res->keep_alive(keep_alive);
+    res->body() = std::move(r.body);
+    res->prepare_payload();
+    write(res);
+  }
+
+  void write(std::shared_ptr<bhttp::response<bhttp::string_body>> res) {
+    stream_.expires_after(std::chrono::milliseconds(static_cast<long>(shared_->limits.read_timeout_s * 1000)));
+    bhttp::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code ec, std::size_t) {
+      if (ec) return fail(ec, "write");
+      if (!res->keep_alive()) return self->do_close();
+      self->do_read();
+    });
+  }
+
+  void do_close() {
+    beast::error_code ec;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+    if (draining_) drain();
+  }
+
+  // After refusing a request whose body we did not read, read and discard what the peer still
+  // sends (bounded, 2 s) before closing: closing with unread data resets the connection, and a
+  // reset can destroy our error response in the peer's buffer before the peer reads it.
+  void drain() {
+    stream_.expires_after(std::chrono::seconds(2));
+    stream_.async_read_some(net::buffer(discard_), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+      self->drained_ += n;
+      if (!ec && self->drained_ < (1u << 20)) self->drain();
+    });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::shared_ptr<HttpServer::Shared> shared_;
+  std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+  bool draining_ = false;
+  std::size_t drained_ = 0;
+  std::array<char, 16384> discard_{};
+};
+
+}  // namespace
+
+class HttpServer::Listener : public std::enable_shared_from_this<HttpServer::Listener> {
+ public:
+  Listener(net::io_context& io, std::shared_ptr<Shared> shared) : io_(io), acceptor_(net::make_strand(io)), shared_(std::move(shared)) {}
+
+  std::error_code open(const tcp::endpoint& ep) {
+    beast::error_code ec;
+    acceptor_.open(ep.protocol(), ec);
+    if (!ec) acceptor_.set_option(net::socket_base::reuse_address(true), ec);
+    if (!ec) acceptor_.bind(ep, ec);
+    if (!ec) acceptor_.listen(net::socket_base::max_listen_connections, ec);
+    return ec;
+  }
+  std::uint16_t port() const { return acceptor_.local_endpoint().port(); }
+  void run() { do_accept(); }
+  void close() {
+    net::post(acceptor_.get_executor(), [self = shared_from_this()] {
+      beast::error_code ec;
+      self->acceptor_.close(ec);
+    });
+  }
+
+ private:
+  void do_accept() {
+    acceptor_.async_accept(net::make_strand(io_), beast::bind_front_handler(&Listener::on_accept, shared_from_this()));
+  }
+  void on_accept(beast::error_code ec, tcp::socket socket) {
+    if (ec) {
+      if (ec == net::error::operation_aborted) return;
+      fail(ec, "accept");
+    } else {
+      const bool over = shared_->connections >= shared_->limits.max_connections;
+      auto session = std::make_shared<Session>(std::move(socket), shared_);
+      if (over) session->refuse();
+      else session->run();
+    }
+    if (acceptor_.is_open()) do_accept();
+  }
+
+  net::io_context& io_;
+  tcp::acceptor acceptor_;
+  std::shared_ptr<Shared> shared_;
+};
+
+HttpServer::HttpServer(net::io_context& io, const Router& router, ServerLimits limits, Observer observer)
+    : io_(io), shared_(std::make_shared<Shared>(router, limits, std::move(observer))) {}
+
+HttpServer::~HttpServer() = default;
+
+std::error_code HttpServer::listen(const std::string& host, std::uint16_t port) {
+  boost::system::error_code ec;
+  net::ip::address addr;
+  if (host == "localhost") addr = net::ip::make_address("127.0.0.1");
+  else addr = net::ip::make_address(host, ec);
+  if (ec) return std::make_error_code(std::errc::invalid_argument);
+  listener_ = std::make_shared<Listener>(io_, shared_);
+  if (auto e = listener_->open(tcp::endpoint(addr, port))) return e;
+  port_ = listener_->port();
+  shared_->hosts = allowed_hosts(host, port_);
+  listener_->run();
+  return {};
+}
+
+void HttpServer::close() {
+  shared_->closing = true;
+  if (listener_) listener_->close();
+}
+
+}  // namespace synbench::http

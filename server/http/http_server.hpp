@@ -1,0 +1,58 @@
+// The daemon's HTTP/1.1 server on Boost.Beast, after Beast's chat-multi example: a listener
+// accepting on one io_context thread and one session per connection, reading one request,
+// answering it through the Router, then reading the next (keep-alive), so at most one write is
+// in flight per session. Limits: header and body size (431, 413), a read/idle timeout, and the
+// Host header must name the listen address (a DNS-rebinding defence) or the request gets 403.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <system_error>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+
+#include "server/http/router.hpp"
+
+namespace synbench::http {
+
+struct ServerLimits {
+  std::size_t max_body_bytes = 64 * 1024;
+  std::size_t max_header_bytes = 8 * 1024;
+  double read_timeout_s = 15;  // for one whole request, and for idling between requests
+  std::size_t max_connections = 64;  // beyond this, a new connection gets 503 and is closed
+};
+
+// Host header values accepted for a server listening on host:port: "host:port", and for a
+// loopback address also "localhost:port", "127.0.0.1:port" and "[::1]:port".
+std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_t port);
+
+class HttpServer {
+ public:
+  // Called for each answered request: method, path (no query), status. For metrics and logs;
+  // never sees headers, so never a token.
+  using Observer = std::function<void(const std::string& method, const std::string& path, int status)>;
+
+  HttpServer(boost::asio::io_context& io, const Router& router, ServerLimits limits, Observer observer = {});
+  ~HttpServer();
+  // Binds and listens; port 0 picks a free one (see port()).
+  std::error_code listen(const std::string& host, std::uint16_t port);
+  std::uint16_t port() const { return port_; }
+  // Stops accepting; open sessions end after their current request.
+  void close();
+
+  struct Shared;  // state every session shares (router, limits, allowed hosts)
+
+ private:
+  class Listener;
+  boost::asio::io_context& io_;
+  std::shared_ptr<Shared> shared_;
+  std::shared_ptr<Listener> listener_;
+  std::uint16_t port_ = 0;
+};
+
+}  // namespace synbench::http

@@ -1,0 +1,220 @@
+// Route matching, bearer auth and the OpenAPI document of the route table.
+#include "server/http/router.hpp"
+
+#include <exception>
+#include <set>
+
+namespace synbench::http {
+
+const char* role_name(Role r) {
+  switch (r) {
+    case Role::anyone: return "anyone";
+    case Role::viewer: return "viewer";
+    case Role::operator_: return "operator";
+  }
+  return "?";
+}
+
+std::optional<Role> parse_role(std::string_view name) {
+  if (name == "viewer") return Role::viewer;
+  if (name == "operator") return Role::operator_;
+  return std::nullopt;
+}
+
+Response json_response(int status, const nlohmann::json& body) {
+  Response r;
+  r.status = status;
+  r.body = body.dump();
+  return r;
+}
+
+Response error_response(int status, const std::string& code, const std::string& message) {
+  return json_response(status, {{"error", {{"code", code}, {"message", message}}}});
+}
+
+namespace {
+
+std::vector<std::string_view> segments(std::string_view path) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i <= path.size()) {
+    const std::size_t j = path.find('/', i);
+    const std::size_t end = j == std::string_view::npos ? path.size() : j;
+    if (end > i) out.push_back(path.substr(i, end - i));
+    if (j == std::string_view::npos) break;
+    i = j + 1;
+  }
+  return out;
+}
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+std::string decode(std::string_view s) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '+') out.push_back(' ');
+    else if (s[i] == '%' && i + 2 < s.size() && hex_value(s[i + 1]) >= 0 && hex_value(s[i + 2]) >= 0) {
+      out.push_back(static_cast<char>(hex_value(s[i + 1]) * 16 + hex_value(s[i + 2])));
+      i += 2;
+    } else out.push_back(s[i]);
+  }
+  return out;
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, std::string> parse_query(std::string_view query) {
+  std::map<std::string, std::string> out;
+  std::size_t i = 0;
+  while (i < query.size()) {
+    std::size_t amp = query.find('&', i);
+    if (amp == std::string_view::npos) amp = query.size();
+    const std::string_view pair = query.substr(i, amp - i);
+    if (!pair.empty()) {
+      const std::size_t eq = pair.find('=');
+      if (eq == std::string_view::npos) out[decode(pair)] = "";
+      else out[decode(pair.substr(0, eq))] = decode(pair.substr(eq + 1));
+    }
+    i = amp + 1;
+  }
+  return out;
+}
+
+bool match_pattern(std::string_view pattern, std::string_view path, std::map<std::string, std::string>& params) {
+  const auto p = segments(pattern), s = segments(path);
+  if (p.size() != s.size()) return false;
+  std::map<std::string, std::string> found;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p[i].size() > 2 && p[i].front() == '{' && p[i].back() == '}')
+      found[std::string(p[i].substr(1, p[i].size() - 2))] = decode(s[i]);
+    else if (p[i] != s[i]) return false;
+  }
+  params = std::move(found);
+  return true;
+}
+
+void Router::add(Route route) { routes_.push_back(std::move(route)); }
+
+Response Router::dispatch(const std::string& method, const std::string& target, std::string_view authorization,
+                          std::string body) const {
+  Request req;
+  req.method = method;
+  const std::size_t q = target.find('?');
+  req.path = target.substr(0, q);
+  if (q != std::string::npos) req.query = parse_query(std::string_view(target).substr(q + 1));
+  req.body = std::move(body);
+
+  const Route* route = nullptr;
+  std::set<std::string> allowed;
+  for (const Route& r : routes_) {
+    std::map<std::string, std::string> params;
+    if (!match_pattern(r.pattern, req.path, params)) continue;
+    allowed.insert(r.method);
+    // HEAD is answered like GET (the session drops the body).
+    if (r.method == method || (method == "HEAD" && r.method == "GET")) {
+      route = &r;
+      req.params = std::move(params);
+      break;
+    }
+  }
+  if (!route) {
+    if (allowed.empty()) return error_response(404, "not_found", "no route for " + req.path);
+    std::string allow;
+    for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
+    Response r = error_response(405, "method_not_allowed", method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+    r.headers.emplace_back("Allow", allow);
+    return r;
+  }
+
+  // The token is checked whenever one is given, so a bad token is reported even on open routes
+  // only when they need one; the token itself never appears in a message.
+  std::optional<Identity> caller;
+  bool token_given = false;
+  if (!authorization.empty()) {
+    token_given = true;
+    const std::size_t sp = authorization.find(' ');
+    if (sp != std::string_view::npos && lower(authorization.substr(0, sp)) == "bearer") {
+      std::string_view token = authorization.substr(sp + 1);
+      while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
+      if (auth_) caller = auth_(token);
+    }
+  }
+  if (route->role != Role::anyone) {
+    auto challenge = [](Response r) {
+      r.headers.emplace_back("WWW-Authenticate", "Bearer realm=\"synbench\"");
+      return r;
+    };
+    if (!token_given) return challenge(error_response(401, "unauthorized", "this route needs a bearer token (Authorization: Bearer TOKEN)"));
+    if (!caller) return challenge(error_response(401, "unauthorized", "the bearer token is not valid"));
+    if (static_cast<int>(caller->role) < static_cast<int>(route->role))
+      return error_response(403, "forbidden", std::string("this route needs the ") + role_name(route->role) +
+                                                  " role; the token has " + role_name(caller->role));
+  }
+  if (caller) {
+    req.caller = caller->role;
+    req.caller_id = caller->id;
+  }
+  try {
+    return route->handler(req);
+  } catch (const std::exception& e) {
+    return error_response(500, "internal", e.what());
+  }
+}
+
+nlohmann::json Router::openapi(const std::string& title, const std::string& version) const {
+  nlohmann::json paths = nlohmann::json::object();
+  for (const Route& r : routes_) {
+    nlohmann::json op;
+    op["summary"] = r.summary;
+    op["operationId"] = lower(r.method) + r.pattern;
+    op["x-synbench-role"] = role_name(r.role);
+    if (r.role != Role::anyone) op["security"] = nlohmann::json::array({{{"bearer", nlohmann::json::array()}}});
+    else op["security"] = nlohmann::json::array();
+    nlohmann::json params = nlohmann::json::array();
+    for (auto seg : segments(r.pattern))
+      if (seg.size() > 2 && seg.front() == '{')
+        params.push_back({{"name", std::string(seg.substr(1, seg.size() - 2))}, {"in", "path"}, {"required", true},
+                          {"schema", {{"type", "string"}}}});
+    if (!params.empty()) op["parameters"] = params;
+    if (r.request_schema)
+      op["requestBody"] = {{"required", true}, {"content", {{"application/json", {{"schema", *r.request_schema}}}}}};
+    nlohmann::json responses = {{"200", {{"description", "success"}}},
+                                {"default", {{"description", "error"},
+                                             {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}}};
+    if (r.role != Role::anyone) {
+      responses["401"] = {{"description", "no or invalid bearer token"}};
+      responses["403"] = {{"description", std::string("the token's role is below ") + role_name(r.role)}};
+    }
+    op["responses"] = responses;
+    paths[r.pattern][lower(r.method)] = op;
+  }
+  return {
+      {"openapi", "3.0.3"},
+      {"info", {{"title", title}, {"version", version}}},
+      {"paths", paths},
+      {"components",
+       {{"securitySchemes", {{"bearer", {{"type", "http"}, {"scheme", "bearer"}}}}},
+        {"schemas",
+         {{"Error",
+           {{"type", "object"},
+            {"required", {"error"}},
+            {"properties",
+             {{"error",
+               {{"type", "object"},
+                {"required", {"code", "message"}},
+                {"properties", {{"code", {{"type", "string"}}}, {"message", {{"type", "string"}}}}}}}}}}}}}}},
+  };
+}
+
+}  // namespace synbench::http

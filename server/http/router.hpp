@@ -1,0 +1,92 @@
+// The daemon's REST surface as data: a route table (method, path pattern with {name} segments,
+// required role, OpenAPI summary, handler) and a pure dispatcher. Handlers are functions of the
+// request (their context captured when the table is built); nothing here touches a socket, so
+// routing, auth and the OpenAPI document are unit-tested without a server.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace synbench::http {
+
+// What a caller may do. `anyone` needs no token; `viewer` reads; `operator_` commands the bench.
+enum class Role { anyone = 0, viewer = 1, operator_ = 2 };
+const char* role_name(Role r);
+std::optional<Role> parse_role(std::string_view name);  // "viewer" or "operator"
+
+struct Request {
+  std::string method;                         // "GET", "POST", ...
+  std::string path;                           // without the query
+  std::map<std::string, std::string> query;   // decoded ?a=b&c=d
+  std::map<std::string, std::string> params;  // {name} segments of the matched pattern
+  std::string body;
+  Role caller = Role::anyone;                 // the authenticated role, set by the dispatcher
+  std::string caller_id;                      // who: a label of the token (never the token), or ""
+};
+
+struct Response {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::vector<std::pair<std::string, std::string>> headers;  // extra headers (Allow, ...)
+};
+
+Response json_response(int status, const nlohmann::json& body);
+// {"error": {"code": code, "message": message}}
+Response error_response(int status, const std::string& code, const std::string& message);
+
+using Handler = std::function<Response(const Request&)>;
+
+struct Route {
+  Route(std::string m, std::string p, Role r, std::string s, Handler h, std::optional<nlohmann::json> schema = std::nullopt)
+      : method(std::move(m)), pattern(std::move(p)), role(r), summary(std::move(s)), handler(std::move(h)),
+        request_schema(std::move(schema)) {}
+  std::string method;
+  std::string pattern;  // "/api/sweeps/{id}/start"
+  Role role = Role::viewer;
+  std::string summary;  // one line, for the OpenAPI document and docs/api.md
+  Handler handler;
+  std::optional<nlohmann::json> request_schema;  // JSON Schema of the body, if it takes one
+};
+
+// A token's role and a label naming its holder in messages and the control lock (the first
+// digits of the token's digest: never the token).
+struct Identity {
+  Role role = Role::viewer;
+  std::string id;
+};
+// Maps a bearer token to its identity; nullopt for an unknown token.
+using Authenticator = std::function<std::optional<Identity>(std::string_view token)>;
+
+class Router {
+ public:
+  explicit Router(Authenticator auth) : auth_(std::move(auth)) {}
+  void add(Route route);
+  const std::vector<Route>& routes() const { return routes_; }
+
+  // `target` is the request-target ("/api/x?y=z"); `authorization` the Authorization header
+  // (empty when absent). 404 unknown path, 405 wrong method, 401 no or unknown token, 403 role
+  // too low; otherwise the handler's response. Never throws: a handler's exception is a 500.
+  Response dispatch(const std::string& method, const std::string& target,
+                    std::string_view authorization, std::string body) const;
+
+  // OpenAPI 3.0 document generated from the table.
+  nlohmann::json openapi(const std::string& title, const std::string& version) const;
+
+ private:
+  Authenticator auth_;
+  std::vector<Route> routes_;
+};
+
+// Splits "?a=1&b=x%20y" into decoded pairs; exposed for tests.
+std::map<std::string, std::string> parse_query(std::string_view query);
+// True when `path` matches `pattern`; fills `params` with the {name} segments.
+bool match_pattern(std::string_view pattern, std::string_view path, std::map<std::string, std::string>& params);
+
+}  // namespace synbench::http

@@ -1,0 +1,158 @@
+// POST /api/sweeps; GET /api/sweeps, /api/sweeps/{id}, /api/sweeps/{id}/points; see sweep_routes.hpp, docs/api.md.
+#include "server/http/sweep_routes.hpp"
+
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include "bench/sweep_plan.hpp"
+#include "db/export.hpp"
+#include "server/http/api_routes.hpp"
+
+namespace synbench::http {
+namespace {
+
+template <class T>
+nlohmann::json optional_json(const std::optional<T>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json sweep_json(const db::Sweep& s, bool with_plan) {
+  nlohmann::json j = {{"id", s.id},
+                      {"name", s.meta.name},
+                      {"state", std::string(db::name(s.state))},
+                      {"total_points", s.meta.total_points},
+                      {"points_stored", s.points_stored},
+                      {"created_at", s.created_at},
+                      {"started_at", optional_json(s.started_at)},
+                      {"finished_at", optional_json(s.finished_at)},
+                      {"last_error", optional_json(s.last_error)},
+                      {"software_version", s.meta.software_version}};
+  if (with_plan) j["plan"] = nlohmann::json::parse(s.meta.plan.dump());
+  return j;
+}
+
+// The {id} segment as a positive integer, or a 400 naming it.
+std::optional<std::int64_t> sweep_id(const Request& req, Response& error) {
+  const std::string& text = req.params.at("id");
+  char* end = nullptr;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || v <= 0) {
+    error = error_response(400, "bad_field", "id: '" + text + "' is not a sweep id (a positive integer)");
+    return std::nullopt;
+  }
+  return v;
+}
+
+Response db_error(const db::Error& e) {
+  if (e.code == db::make_error_code(db::errc::not_found)) return error_response(404, "not_found", e.message);
+  return error_response(500, "database", e.message);
+}
+
+}  // namespace
+
+void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, std::filesystem::path db_path,
+                      nlohmann::ordered_json bench_config) {
+  db::Store* db = &store;
+  BenchRuntime* runtime = &bench;
+  ControlLock* lock = &control;
+  router.add({"POST", "/api/sweeps/{id}/start", Role::operator_,
+              "Run the sweep on the daemon's bench (a stopped one resumes at its first missing point).",
+              [db, runtime, lock, db_path](const Request& req) {
+                if (!lock->claim(req.caller_id)) return locked(*lock);
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                auto s = db->get_sweep(*id);
+                if (!s) return db_error(s.error());
+                if (s->state == db::SweepState::completed)
+                  return error_response(409, "invalid_state", "sweep " + std::to_string(*id) + " is already completed");
+                auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(s->meta.plan.dump()));
+                if (!parsed.plan) return error_response(500, "bad_plan", "the stored plan no longer parses");
+                auto rows = db->points(*id);
+                if (!rows) return db_error(rows.error());
+                std::map<std::size_t, bench::PointRecord> stored;
+                for (const auto& row : *rows) stored[static_cast<std::size_t>(row.index)] = row.record;
+                if (auto r = runtime->start_sweep(*id, std::move(*parsed.plan), std::move(stored), db_path))
+                  return error_response(r->status, r->code, r->message);
+                return json_response(202, status_json(runtime->status()));
+              }});
+  for (const char* action : {"pause", "resume", "abort"}) {
+    const std::string a = action;
+    const std::string summary = a == "pause"    ? "Pause the running sweep after its point in flight."
+                                : a == "resume" ? "Resume the paused sweep."
+                                                : "Abort the running sweep: drop the point in flight, ordered stop.";
+    router.add({"POST", "/api/sweeps/{id}/" + a, Role::operator_, summary, [runtime, lock, a](const Request& req) {
+                  if (!lock->claim(req.caller_id)) return locked(*lock);
+                  Response err;
+                  const auto id = sweep_id(req, err);
+                  if (!id) return err;
+                  if (auto r = runtime->sweep_action(*id, a)) return error_response(r->status, r->code, r->message);
+                  return json_response(200, status_json(runtime->status()));
+                }});
+  }
+  router.add({"POST", "/api/sweeps", Role::operator_,
+              "Create a sweep from a plan (docs/sweep-plan.md): 201 with its id, state created.",
+              [db, lock, bench_config](const Request& req) {
+                if (!lock->claim(req.caller_id)) return locked(*lock);
+                auto parsed = parse_json_object(req.body);
+                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
+                if (!plan.errors.empty() || !plan.plan) {
+                  // Every problem, each at its JSON pointer.
+                  std::string message;
+                  for (const auto& e : plan.errors) message += (message.empty() ? "" : "; ") + bench::to_string(e);
+                  Response r = error_response(400, "bad_plan", message.empty() ? "the plan does not parse" : message);
+                  return r;
+                }
+                db::SweepMeta meta;
+                meta.name = plan.plan->name.empty() ? "sweep" : plan.plan->name;
+                meta.plan = bench::to_json(*plan.plan);
+                meta.bench_config = bench_config;
+                meta.total_points = static_cast<std::int64_t>(bench::estimate(*plan.plan).points);
+                auto created = db->create_sweep(meta);
+                if (!created) return db_error(created.error());
+                auto s = db->get_sweep(*created);
+                if (!s) return db_error(s.error());
+                return json_response(201, sweep_json(*s, true));
+              },
+              nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
+  router.add({"GET", "/api/sweeps", Role::viewer, "Run history: every sweep in the store, by id.", [db](const Request&) {
+                auto list = db->list_sweeps();
+                if (!list) return db_error(list.error());
+                nlohmann::json out = nlohmann::json::array();
+                for (const auto& s : *list) out.push_back(sweep_json(s, false));
+                return json_response(200, out);
+              }});
+  router.add({"GET", "/api/sweeps/{id}", Role::viewer, "One sweep: state, progress, timestamps, its plan.",
+              [db](const Request& req) {
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                auto s = db->get_sweep(*id);
+                if (!s) return db_error(s.error());
+                return json_response(200, sweep_json(*s, true));
+              }});
+  router.add({"GET", "/api/sweeps/{id}/points", Role::viewer,
+              "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv.", [db](const Request& req) {
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                const auto format = req.query.count("format") ? req.query.at("format") : std::string("json");
+                if (format != "json" && format != "csv")
+                  return error_response(400, "bad_field", "format: '" + format + "' is not json or csv");
+                if (auto s = db->get_sweep(*id); !s) return db_error(s.error());
+                auto rows = db->points(*id);
+                if (!rows) return db_error(rows.error());
+                Response r;
+                if (format == "csv") {
+                  r.content_type = "text/csv; charset=utf-8";
+                  r.body = db::points_to_csv(*rows);
+                } else {
+                  r.body = db::points_to_json(*rows).dump();
+                }
+                return r;
+              }});
+}
+
+}  // namespace synbench::http

@@ -1,0 +1,21 @@
+// Sweep routes over the daemon's SQLite store (DATA_DIR/synbench.db): create a sweep from a
+// plan, run it on the daemon's bench (start, pause, resume, abort), the run history,
+// and each sweep's points as JSON or CSV. The Store is one connection used only from the HTTP
+// thread, as db/store.hpp asks.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "db/store.hpp"
+#include "server/http/api_routes.hpp"
+#include "server/http/bench_runtime.hpp"
+#include "server/http/router.hpp"
+
+namespace synbench::http {
+
+// `bench_config`: the twin config in use, stored with each created sweep. `db_path`: the
+// store's file, which the bench thread opens for the sweep it runs.
+void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, std::filesystem::path db_path,
+                      nlohmann::ordered_json bench_config);
+
+}  // namespace synbench::http

@@ -1,0 +1,148 @@
+// Token file handling; see tokens.hpp.
+#include "server/http/tokens.hpp"
+
+#include <fcntl.h>
+#include <sys/random.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "server/http/sha256.hpp"
+
+namespace synbench::http {
+
+bool constant_time_equal(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    diff = static_cast<unsigned char>(diff | (static_cast<unsigned char>(a[i]) ^ static_cast<unsigned char>(b[i])));
+  return diff == 0;
+}
+
+std::string new_token() {
+  unsigned char bytes[32];
+  std::size_t got = 0;
+  while (got < sizeof bytes) {
+    const ssize_t n = getrandom(bytes + got, sizeof bytes - got, 0);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw std::system_error(errno, std::generic_category(), "getrandom");
+    }
+    got += static_cast<std::size_t>(n);
+  }
+  std::string out = "sbt_";
+  char buf[3];
+  for (unsigned char b : bytes) {
+    std::snprintf(buf, sizeof buf, "%02x", b);
+    out += buf;
+  }
+  return out;
+}
+
+std::error_code write_private_file(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd < 0) return {errno, std::generic_category()};
+  ::fchmod(fd, 0600);  // an older temporary file may have had wider permissions
+  std::size_t off = 0;
+  while (off < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + off, text.size() - off);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::error_code ec(errno, std::generic_category());
+      ::close(fd);
+      return ec;
+    }
+    off += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) return {errno, std::generic_category()};
+  if (::rename(tmp.c_str(), path.c_str()) != 0) return {errno, std::generic_category()};
+  return {};
+}
+
+namespace {
+
+std::string utc_now() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+}  // namespace
+
+std::error_code TokenStore::load() {
+  std::lock_guard lock(mutex_);
+  return load_locked();
+}
+
+std::error_code TokenStore::load_locked() {
+  std::error_code ec;
+  if (!std::filesystem::exists(file_, ec)) {
+    entries_.clear();
+    return {};
+  }
+  std::ifstream in(file_);
+  if (!in) return std::make_error_code(std::errc::permission_denied);
+  const auto doc = nlohmann::json::parse(in, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("tokens") || !doc["tokens"].is_array())
+    return std::make_error_code(std::errc::invalid_argument);
+  std::vector<TokenEntry> entries;
+  for (const auto& t : doc["tokens"]) {
+    if (!t.is_object() || !t.contains("sha256") || !t["sha256"].is_string() || !t.contains("role") || !t["role"].is_string())
+      return std::make_error_code(std::errc::invalid_argument);
+    const auto role = parse_role(t["role"].get<std::string>());
+    if (!role) return std::make_error_code(std::errc::invalid_argument);
+    entries.push_back({t["sha256"].get<std::string>(), *role, t.value("created", "")});
+  }
+  entries_ = std::move(entries);
+  loaded_mtime_ = std::filesystem::last_write_time(file_, ec);
+  return {};
+}
+
+bool TokenStore::empty() const {
+  std::lock_guard lock(mutex_);
+  return entries_.empty();
+}
+
+std::string TokenStore::create(Role role, std::error_code& ec) {
+  std::lock_guard lock(mutex_);
+  ec = load_locked();  // keep tokens another process added meanwhile
+  if (ec) return {};
+  const std::string token = new_token();
+  entries_.push_back({sha256_hex(token), role, utc_now()});
+  nlohmann::json doc = {{"tokens", nlohmann::json::array()}};
+  for (const auto& e : entries_) doc["tokens"].push_back({{"sha256", e.sha256}, {"role", role_name(e.role)}, {"created", e.created}});
+  std::error_code mk;
+  if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path(), mk);
+  ec = write_private_file(file_, doc.dump(2) + "\n");
+  if (ec) return {};
+  std::error_code te;
+  loaded_mtime_ = std::filesystem::last_write_time(file_, te);
+  return token;
+}
+
+std::optional<Identity> TokenStore::authenticate(std::string_view token) {
+  std::lock_guard lock(mutex_);
+  std::error_code ec;
+  const auto mtime = std::filesystem::last_write_time(file_, ec);
+  if (!ec && mtime != loaded_mtime_) load_locked();  // a broken file keeps the tokens we had
+  const std::string digest = sha256_hex(token);
+  std::optional<Identity> found;
+  // Every entry is compared, so the time taken says nothing about which one matched.
+  for (const auto& e : entries_)
+    if (constant_time_equal(digest, e.sha256)) found = Identity{e.role, "token-" + digest.substr(0, 8)};
+  return found;
+}
+
+}  // namespace synbench::http

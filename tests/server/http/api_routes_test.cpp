@@ -1,0 +1,94 @@
+// The REST routes on the real-time twin, called through the Router without a socket: every
+// mutating route needs an operator, setpoints are validated naming the field, and the twin
+// follows a speed setpoint.
+#include "server/http/api_routes.hpp"
+
+#include <thread>
+
+#include <gtest/gtest.h>
+
+namespace synbench::http {
+namespace {
+
+struct Api : ::testing::Test {
+  Api() : bench(emulator::TwinConfig{}, bench::SafetyLimits{}), router([](std::string_view t) -> std::optional<Identity> {
+            if (t == "op") return Identity{Role::operator_, "op"};
+            if (t == "op2") return Identity{Role::operator_, "op2"};
+            if (t == "view") return Identity{Role::viewer, "view"};
+            return std::nullopt;
+          }) {
+    add_api_routes(router, {bench, control, metrics, "test"});
+    bench.start();
+  }
+  ~Api() override { bench.shutdown(); }
+  Response post(const std::string& path, const std::string& body, const std::string& token = "op") {
+    return router.dispatch("POST", path, token.empty() ? "" : "Bearer " + token, body);
+  }
+  BenchRuntime bench;
+  ControlLock control;
+  HttpMetrics metrics;
+  Router router;
+};
+
+TEST_F(Api, EveryMutatingRouteNeedsAnOperator) {
+  for (const auto& r : router.routes()) {
+    if (r.method == "GET") continue;
+    EXPECT_EQ(r.role, Role::operator_) << r.pattern;
+    EXPECT_EQ(router.dispatch(r.method, r.pattern, "", "{}").status, 401) << r.pattern;
+    EXPECT_EQ(router.dispatch(r.method, r.pattern, "Bearer view", "{}").status, 403) << r.pattern;
+  }
+}
+
+TEST_F(Api, SetpointsAreValidatedNamingTheField) {
+  auto bad = post("/api/bench/setpoints", R"({"speed_rpm": 9000})");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_NE(bad.body.find("speed_rpm"), std::string::npos);
+  bad = post("/api/bench/setpoints", R"({"angle_deg": "x"})");
+  EXPECT_NE(bad.body.find("angle_deg"), std::string::npos);
+  bad = post("/api/bench/setpoints", R"({"speed": 100})");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_NE(bad.body.find("speed: unknown field"), std::string::npos);
+  bad = post("/api/bench/setpoints", R"({"speed_rpm": )");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_NE(bad.body.find("bad_json"), std::string::npos);
+  EXPECT_NE(bad.body.find("column"), std::string::npos);
+}
+
+TEST_F(Api, TwinFollowsSpeedSetpointAndEstopLatches) {
+  ASSERT_EQ(post("/api/bench/setpoints", R"({"speed_rpm": 300, "angle_deg": 50})").status, 200);
+  ASSERT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 200);
+  double speed = 0;
+  for (int i = 0; i < 60 && std::abs(speed - 300) > 20; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    speed = nlohmann::json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body)["synrm"]["speed_rpm"];
+  }
+  EXPECT_NEAR(speed, 300, 20);
+  const auto e = post("/api/bench/estop", "");
+  ASSERT_EQ(e.status, 200);
+  const auto s = nlohmann::json::parse(e.body);
+  EXPECT_EQ(s["supervisor"]["phase"], "estopped");
+  EXPECT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 409);
+  EXPECT_EQ(post("/api/bench/reset", "").status, 200);
+}
+
+TEST_F(Api, OneOperatorHoldsTheControlLockButAnyoneMayEstop) {
+  ASSERT_EQ(post("/api/bench/setpoints", R"({"speed_rpm": 100})", "op").status, 200);
+  const auto other = post("/api/bench/setpoints", R"({"speed_rpm": 200})", "op2");
+  EXPECT_EQ(other.status, 409);
+  EXPECT_NE(other.body.find("\"locked\""), std::string::npos);
+  EXPECT_EQ(router.dispatch("DELETE", "/api/bench/lock", "Bearer op2", "").status, 409);
+  EXPECT_EQ(post("/api/bench/estop", "", "op2").status, 200);
+  EXPECT_EQ(router.dispatch("DELETE", "/api/bench/lock", "Bearer op", "").status, 200);
+  EXPECT_EQ(post("/api/bench/lock", "", "op2").status, 200);
+  EXPECT_EQ(post("/api/bench/reset", "", "op2").status, 200);
+  EXPECT_EQ(post("/api/bench/reset", "", "op").status, 409);
+}
+
+TEST_F(Api, MetricsArePrometheusText) {
+  const auto m = router.dispatch("GET", "/metrics", "", "");
+  EXPECT_EQ(m.status, 200);
+  EXPECT_NE(m.body.find("# TYPE synbench_loop_ticks_total counter"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace synbench::http

@@ -1,0 +1,331 @@
+#!/usr/bin/env python3
+"""`synbench serve` over real HTTP on loopback: health, the OpenAPI document, every route of the
+table enumerated from it (mutating routes: 401 without a token, 403 with a viewer token), the
+Host check, body limit, JSON errors, the twin following a speed setpoint, E-stop, the token
+subcommand, and SIGTERM -> ordered stop, exit 0. Standard library only.
+
+usage: serve_test.py path/to/synbench
+"""
+import http.client
+import json
+import os
+import re
+import signal
+import socket
+import stat
+import subprocess
+import sys
+import tempfile
+import time
+
+BIN = sys.argv[1]
+failures = []
+
+
+def check(cond, what):
+    if not cond:
+        failures.append(what)
+        print("FAIL:", what)
+
+
+class Daemon:
+    def __init__(self, data_dir):
+        self.proc = subprocess.Popen([BIN, "serve", "--listen", "127.0.0.1:0", "--data-dir", data_dir],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        line = self.proc.stdout.readline()
+        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line)
+        if not m:
+            self.proc.kill()
+            raise SystemExit("serve did not start: %r %s" % (line, self.proc.stderr.read()))
+        self.port = int(m.group(1))
+
+    def request(self, method, path, body=None, token=None, host=None, headers=None):
+        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
+        h = {"Host": host or "127.0.0.1:%d" % self.port}
+        if token:
+            h["Authorization"] = "Bearer " + token
+        if body is not None and not isinstance(body, (bytes, str)):
+            body = json.dumps(body)
+        if body is not None:
+            h["Content-Type"] = "application/json"
+        h.update(headers or {})
+        conn.request(method, path, body=body, headers=h)
+        r = conn.getresponse()
+        data = r.read()
+        conn.close()
+        return r.status, data, r
+
+
+def error_of(data):
+    doc = json.loads(data)
+    return doc["error"]["code"], doc["error"]["message"]
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="synbench-serve-")
+    data_dir = os.path.join(tmp, "data")
+    # A small sweep in the daemon's store, for the sweep routes.
+    os.makedirs(data_dir)
+    plan = os.path.join(tmp, "plan.json")
+    with open(plan, "w") as f:
+        json.dump({"name": "tiny", "window_s": 0.5,
+                   "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}}, f)
+    r = subprocess.run([BIN, "sweep", plan, "--db", os.path.join(data_dir, "synbench.db")], capture_output=True, text=True)
+    check(r.returncode == 0, "tiny sweep into the data dir (%s)" % r.stderr[-300:])
+    d = Daemon(data_dir)
+    try:
+        token_file = os.path.join(data_dir, "operator.token")
+        check(os.path.exists(token_file), "first start writes operator.token")
+        check(stat.S_IMODE(os.stat(token_file).st_mode) == 0o600, "operator.token is 0600")
+        op = open(token_file).read().strip()
+        tokens_json = open(os.path.join(data_dir, "tokens.json")).read()
+        check(op not in tokens_json, "tokens.json holds no token in clear")
+        viewer = subprocess.run([BIN, "token", "create", "--role", "viewer", "--data-dir", data_dir],
+                                capture_output=True, text=True)
+        check(viewer.returncode == 0, "token create exits 0")
+        viewer = viewer.stdout.strip()
+        bad = subprocess.run([BIN, "token", "create", "--role", "admin", "--data-dir", data_dir], capture_output=True, text=True)
+        check(bad.returncode == 2 and "--role" in bad.stderr, "token create --role admin: exit 2 naming --role")
+
+        status, data, _ = d.request("GET", "/api/health")
+        check(status == 200 and json.loads(data)["status"] == "ok", "health 200")
+
+        status, data, _ = d.request("GET", "/api/openapi.json")
+        check(status == 200, "openapi 200")
+        doc = json.loads(data)
+        check(doc["openapi"].startswith("3."), "OpenAPI 3")
+        routes = [(m.upper(), p, op_["x-synbench-role"]) for p, ms in doc["paths"].items() for m, op_ in ms.items()]
+        for expected in [("GET", "/api/health"), ("GET", "/api/sweeps"), ("GET", "/api/sweeps/{id}/points"), ("GET", "/api/bench/status"), ("POST", "/api/bench/estop"),
+                         ("POST", "/api/bench/reset"), ("POST", "/api/bench/setpoints"), ("POST", "/api/bench/enable"),
+                         ("GET", "/metrics"), ("GET", "/api/openapi.json")]:
+            check(any(r[0] == expected[0] and r[1] == expected[1] for r in routes), "openapi lists %s %s" % expected)
+
+        # Every route of the table, enumerated from the document.
+        for method, path, role in routes:
+            concrete = re.sub(r"\{[^}]+\}", "1", path)
+            if method != "GET":
+                check(role == "operator", "%s %s needs operator" % (method, path))
+                s, data, r = d.request(method, concrete, body={})
+                check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
+                check(error_of(data)[0] == "unauthorized", "%s %s 401 is a JSON error" % (method, path))
+                check(r.getheader("WWW-Authenticate", "").startswith("Bearer"), "401 carries WWW-Authenticate")
+                s, _, _ = d.request(method, concrete, body={}, token="sbt_" + "0" * 64)
+                check(s == 401, "%s %s with an unknown token -> 401" % (method, path))
+                s, data, _ = d.request(method, concrete, body={}, token=viewer)
+                check(s == 403, "%s %s with viewer -> 403 (got %d)" % (method, path, s))
+                check(error_of(data)[0] == "forbidden", "%s %s 403 is a JSON error" % (method, path))
+            else:
+                s, _, _ = d.request(method, concrete, token=viewer if role != "anyone" else None)
+                check(s == 200, "%s %s as %s -> 200 (got %d)" % (method, path, role, s))
+                if role != "anyone":
+                    s, _, _ = d.request(method, concrete)
+                    check(s == 401, "%s %s without token -> 401" % (method, path))
+
+        # Sweeps from the store.
+        s, data, _ = d.request("GET", "/api/sweeps", token=viewer)
+        sweeps = json.loads(data)
+        check(s == 200 and len(sweeps) == 1 and sweeps[0]["name"] == "tiny" and sweeps[0]["points_stored"] == 2,
+              "GET /api/sweeps lists the tiny sweep")
+        s, data, _ = d.request("GET", "/api/sweeps/1", token=viewer)
+        check(s == 200 and json.loads(data)["state"] == "completed" and "plan" in json.loads(data), "GET /api/sweeps/1")
+        s, data, _ = d.request("GET", "/api/sweeps/1/points", token=viewer)
+        check(s == 200 and len(json.loads(data)) == 2 and json.loads(data)[0]["point_index"] == 0, "points as JSON")
+        s, data, r = d.request("GET", "/api/sweeps/1/points?format=csv", token=viewer)
+        lines = data.decode().splitlines()
+        check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("point_index")
+              and len(lines) == 3, "points as CSV")
+        tiny = {"name": "rest", "window_s": 0.5, "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}}
+        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        created = json.loads(data)
+        check(s == 201 and created["state"] == "created" and created["total_points"] == 2, "POST /api/sweeps -> 201 created")
+        s, data, _ = d.request("POST", "/api/sweeps", body={"dimensions": {"speed_rpm": [-5]}}, token=op)
+        check(s == 400 and error_of(data)[0] == "bad_plan" and "/dimensions/speed_rpm" in error_of(data)[1],
+              "bad plan -> 400 naming the JSON pointer (%s)" % data[:200])
+        r = subprocess.run([BIN, "sweep", "--resume", str(created["id"]), "--db", os.path.join(data_dir, "synbench.db"), "--quiet"],
+                           capture_output=True, text=True)
+        check(r.returncode == 0, "a sweep created over REST runs with synbench sweep --resume")
+        s, data, _ = d.request("GET", "/api/sweeps/%d" % created["id"], token=viewer)
+        check(s == 200 and json.loads(data)["state"] == "completed" and json.loads(data)["points_stored"] == 2,
+              "the daemon sees the sweep completed")
+        # A sweep run by the daemon's own bench, in real time.
+        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        sid = json.loads(data)["id"]
+        s, data, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        check(s == 202, "start a sweep on the daemon -> 202 (%s)" % data[:200])
+        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        check(s == 409 and error_of(data)[0] == "sweep_running", "manual enable refused during a sweep")
+        s, data, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        check(s == 409, "a second start is refused")
+        state = None
+        deadline = time.time() + 60
+        while time.time() < deadline:
+            _, data, _ = d.request("GET", "/api/sweeps/%d" % sid, token=viewer)
+            sw = json.loads(data)
+            state = sw["state"]
+            if state not in ("created", "running"):
+                break
+            time.sleep(0.5)
+        check(state == "completed" and sw["points_stored"] == 2, "the daemon's sweep completes with 2 points (%s)" % state)
+        _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+        check(json.loads(data)["sweep"]["state"] == "completed", "status shows the last sweep")
+        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        sid = json.loads(data)["id"]
+        d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        s, data, _ = d.request("POST", "/api/sweeps/%d/abort" % sid, token=op)
+        check(s == 200, "abort a running sweep")
+        deadline = time.time() + 30
+        while time.time() < deadline:
+            _, data, _ = d.request("GET", "/api/sweeps/%d" % sid, token=viewer)
+            state = json.loads(data)["state"]
+            if state != "running":
+                break
+            time.sleep(0.3)
+        check(state == "aborted", "the aborted sweep is recorded aborted (%s)" % state)
+        s, data, _ = d.request("POST", "/api/sweeps/%d/pause" % sid, token=op)
+        check(s == 409 and error_of(data)[0] == "not_running", "pause of a sweep not running -> 409")
+
+        s, data, _ = d.request("GET", "/api/sweeps/99", token=viewer)
+        check(s == 404 and error_of(data)[0] == "not_found", "unknown sweep -> 404")
+        s, data, _ = d.request("GET", "/api/sweeps/abc", token=viewer)
+        check(s == 400 and error_of(data)[1].startswith("id"), "bad sweep id -> 400 naming id")
+        s, data, _ = d.request("GET", "/api/sweeps/1/points?format=xml", token=viewer)
+        check(s == 400 and error_of(data)[1].startswith("format"), "bad format -> 400 naming format")
+
+        # Limits and errors.
+        s, data, _ = d.request("GET", "/api/health", host="evil.example:%d" % d.port)
+        check(s == 403 and error_of(data)[0] == "host_not_allowed", "foreign Host -> 403")
+        s, _, _ = d.request("GET", "/api/health", host="localhost:%d" % d.port)
+        check(s == 200, "Host localhost:PORT accepted")
+        s, _, _ = d.request("GET", "/api/health", host="127.0.0.1:1")
+        check(s == 403, "Host with another port -> 403")
+        s, data, _ = d.request("POST", "/api/bench/setpoints", body="x" * (65 * 1024), token=op)
+        check(s == 413 and error_of(data)[0] == "body_too_large", "body over the limit -> 413")
+        s, data, _ = d.request("POST", "/api/bench/setpoints", body='{"speed_rpm": ', token=op)
+        check(s == 400 and error_of(data)[0] == "bad_json" and "column" in error_of(data)[1], "bad JSON -> 400 naming the position")
+        s, data, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 99999}, token=op)
+        check(s == 400 and error_of(data)[1].startswith("speed_rpm"), "out-of-range setpoint names the field")
+        s, data, _ = d.request("GET", "/api/nowhere", token=viewer)
+        check(s == 404 and error_of(data)[0] == "not_found", "unknown route -> 404 JSON")
+        s, _, r = d.request("DELETE", "/api/bench/status", token=op)
+        check(s == 405 and r.getheader("Allow") == "GET", "wrong method -> 405 with Allow")
+        s, _, _ = d.request("GET", "/api/health", headers={"X-Big": "y" * 10000})
+        check(s == 431, "header over the limit -> 431 (got %d)" % s)
+
+        # Connection limit: 64 idle connections are held, the 65th gets 503.
+        held = [socket.create_connection(("127.0.0.1", d.port), timeout=10) for _ in range(64)]
+        time.sleep(0.2)
+        extra = socket.create_connection(("127.0.0.1", d.port), timeout=10)
+        reply = extra.recv(4096).decode(errors="replace")
+        check(reply.startswith("HTTP/1.1 503") and "too_many_connections" in reply, "connection 65 -> 503")
+        extra.close()
+        for c in held:
+            c.close()
+        time.sleep(0.3)
+
+        # Keep-alive: two requests on one connection.
+        conn = http.client.HTTPConnection("127.0.0.1", d.port, timeout=10)
+        for _ in range(2):
+            conn.request("GET", "/api/health")
+            resp = conn.getresponse()
+            resp.read()
+            check(resp.status == 200, "keep-alive request")
+        conn.close()
+
+        # The twin follows the operator's setpoint in real time.
+        s, _, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 400, "load_Nm": 0.5, "angle_deg": 50}, token=op)
+        check(s == 200, "setpoints as operator -> 200")
+        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        check(s == 200, "enable -> 200 (%s)" % data)
+        speed = 0.0
+        deadline = time.time() + 15
+        while time.time() < deadline:
+            _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+            st = json.loads(data)
+            speed = st["synrm"]["speed_rpm"] if st["synrm"] else 0.0
+            if abs(speed - 400) < 20:
+                break
+            time.sleep(0.2)
+        check(abs(speed - 400) < 20, "twin speed follows the setpoint (%.1f rpm)" % speed)
+        s, data, _ = d.request("GET", "/metrics")
+        check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
+
+        # The control lock: op holds it since its first command; another operator is refused,
+        # but may always E-stop.
+        op2 = subprocess.run([BIN, "token", "create", "--role", "operator", "--data-dir", data_dir],
+                             capture_output=True, text=True).stdout.strip()
+        s, data, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 100}, token=op2)
+        check(s == 409 and error_of(data)[0] == "locked", "another operator is refused while op holds the lock")
+        s, data, _ = d.request("GET", "/api/bench/lock", token=viewer)
+        check(s == 200 and json.loads(data)["holder"], "GET /api/bench/lock names the holder")
+        check(op not in data.decode(), "the lock holder label is not the token")
+
+        s, data, _ = d.request("POST", "/api/bench/estop", token=op2)
+        st = json.loads(data)
+        check(s == 200 and st["supervisor"]["phase"] == "estopped" and st["supervisor"]["tripped"], "E-stop latches")
+        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        check(s == 409 and error_of(data)[0] == "tripped", "enable refused while tripped")
+        s, _, _ = d.request("POST", "/api/bench/reset", token=op)
+        check(s == 200, "reset after E-stop")
+        s, _, _ = d.request("DELETE", "/api/bench/lock", token=op2)
+        check(s == 409, "op2 cannot release op's lock")
+        s, _, _ = d.request("DELETE", "/api/bench/lock", token=op)
+        check(s == 200, "op releases the lock")
+
+        # Run again, then SIGTERM: ordered stop, exit 0.
+        d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        time.sleep(1)
+        d.proc.send_signal(signal.SIGTERM)
+        try:
+            rc = d.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            d.proc.kill()
+            rc = -1
+        check(rc == 0, "SIGTERM -> exit 0 (got %s)" % rc)
+        err = d.proc.stderr.read()
+        check(op not in err.split("first start")[-1].split("\n", 1)[-1], "the token is logged only at first start")
+        check(viewer not in err, "a created token is never logged")
+    finally:
+        if d.proc.poll() is None:
+            d.proc.kill()
+            d.proc.wait()
+
+    # SIGTERM during a sweep: the sweep is aborted with its committed points kept, exit 0.
+    data_dir2 = os.path.join(tmp, "data2")
+    d = Daemon(data_dir2)
+    try:
+        op = open(os.path.join(data_dir2, "operator.token")).read().strip()
+        s, data, _ = d.request("POST", "/api/sweeps", token=op, body={
+            "preset": "thesis-grid", "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
+        sid = json.loads(data)["id"]
+        s, _, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        check(s == 202, "start the thesis grid")
+        time.sleep(3)
+        d.proc.send_signal(signal.SIGTERM)
+        try:
+            rc = d.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            d.proc.kill()
+            rc = -1
+        check(rc == 0, "SIGTERM during a sweep -> exit 0 (got %s)" % rc)
+        import sqlite3
+        con = sqlite3.connect(os.path.join(data_dir2, "synbench.db"))
+        state = con.execute("select state from sweeps where id = ?", (sid,)).fetchone()[0]
+        con.close()
+        check(state == "aborted", "the interrupted sweep is recorded aborted (%s)" % state)
+    finally:
+        if d.proc.poll() is None:
+            d.proc.kill()
+            d.proc.wait()
+
+    # Bad flags.
+    r = subprocess.run([BIN, "serve", "--listen", "nonsense"], capture_output=True, text=True)
+    check(r.returncode == 2 and "--listen" in r.stderr, "serve --listen nonsense: exit 2 naming --listen")
+
+    if failures:
+        print("%d failure(s)" % len(failures))
+        sys.exit(1)
+    print("serve test ok")
+
+
+if __name__ == "__main__":
+    main()
