@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# A newcomer's first command: installs what is missing, builds, and runs synbench on the
-# embedded twin (until `synbench serve` exists: one emulated operating point).
+# A newcomer's first command: installs what is missing, builds, and starts the synbench daemon
+# on the embedded twin at http://127.0.0.1:8080 (REST API; the dashboard arrives with its issue).
+# The operator token is printed on first start and kept in synbench-data/operator.token.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh release
-exec build/release/server/synbench point --speed-rpm 700 --load-Nm 2.5 --angle-deg 52 "$@"
+exec build/release/server/synbench serve --listen 127.0.0.1:8080 "$@"  # data: ./synbench-data

@@ -110,3 +110,45 @@ TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
 
 }  // namespace
 }  // namespace synbench
+
+namespace synbench {
+namespace {
+
+// Sweep-like chaining (bench/sweep_engine: the drive keeps running, speed, load and current
+// angle change together between points): EEMF-CONST and EEMF-LUT hold their angle through
+// 3 loads x 5 angles at 700 rpm without a fault. (The observers still lose lock above about
+// 55..60 deg at light load, where the EEMF is small: docs/estimators.md; HFI and EEMF-RLS are
+// not covered yet.)
+TEST(ClosedLoopEstimators, EemfHoldsAChainedSequenceOfPoints) {
+  struct Case {
+    drivers::Estimator e;
+    double bound_deg;
+  };
+  for (const Case c : {Case{drivers::Estimator::eemf_const, 15.0}, Case{drivers::Estimator::eemf_lut, 6.0}}) {
+    emulator::TwinConfig cfg;
+    emulator::TwinBench bench(cfg);
+    bench::PointOptions opt;
+    opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
+    opt.ordered_stop_after = false;
+    opt.continue_running = true;
+    opt.settle_timeout_s = 5.0;
+    for (double load : {0.5, 2.0, 3.5})
+      for (double angle : {40.0, 45.0, 50.0, 55.0, 60.0}) {
+        bench::PointRequest req;
+        req.speed_rpm = 700;
+        req.load_Nm = load;
+        req.angle_deg = angle;
+        req.estimator = c.e;
+        req.pwm = drivers::Pwm::capwm;
+        const auto r = bench::run_point(bench.devices(), bench.clock(), req, opt).record();
+        const std::string at = std::string(drivers::name(c.e)) + " " + std::to_string(load) + " N m " +
+                               std::to_string(angle) + " deg";
+        ASSERT_FALSE(r.fault) << at;
+        ASSERT_TRUE(r.pos_err_mean_deg) << at;
+        EXPECT_LE(std::fabs(*r.pos_err_mean_deg), c.bound_deg) << at;
+      }
+  }
+}
+
+}  // namespace
+}  // namespace synbench

@@ -99,8 +99,14 @@ void Eemf::update(const EstimatorInput& in) {
   have_prev_ = true;
   const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w * lq * id);
   const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w * lq * ig);
-  // The EEMF turns with the speed's sign.
-  const double err = w >= 0 ? std::atan2(-eg, ed) : std::atan2(eg, -ed);
+  // The angle error from the EEMF's line, not its arrow [assumed]: atan(-e_g / e_d), modulo
+  // 180 deg. The EEMF (Ld - Lq)(w i_d - p i_q) lies on the q axis but flips its sign when a q-current
+  // transient outruns w i_d (high current angle, low speed): atan2 then reads an error near 180 deg
+  // and the observer runs away. A SynRM does not care about 180 deg. The error is weighted by
+  // |e|^2 / (|e|^2 + e0^2) so that a vanishing EEMF (no current, noise only) does not steer it.
+  const double e2 = eg * eg + ed * ed;
+  const double e0 = p_.emf_floor_V;
+  const double err = 0.5 * std::atan2(-2.0 * eg * ed, ed * ed - eg * eg) * (e2 / (e2 + e0 * e0));
   obs_.correct(err, ts);
 }
 

@@ -30,6 +30,7 @@ struct EemfParams {
   double lut_lq_scale = 1.0;            // kq (4.2)
   double observer_bandwidth_Hz = 5.0;   // Sec. 6.2.3
   double emf_filter_s = 5e-3;           // [assumed] low-pass on e before the angle error
+  double emf_floor_V = 5.0;             // [assumed] |e| below which the angle error is faded out
   double rls_forgetting = 0.99;         // Sec. 6.2.3
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;           // [assumed] RLS sample period (a multiple of ts_s)
