@@ -11,19 +11,13 @@ namespace {
 
 bench::PointRecord measure_with(drivers::Estimator e, double speed, double load, double angle,
                                 drivers::Pwm pwm = drivers::Pwm::capwm) {
-  emulator::TwinConfig cfg;
-  emulator::TwinBench bench(cfg);
   bench::PointRequest req;
   req.speed_rpm = speed;
   req.load_Nm = load;
   req.angle_deg = angle;
   req.estimator = e;
   req.pwm = pwm;
-  bench::PointOptions opt;
-  opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
-  opt.ordered_stop_after = false;
-  opt.settle_timeout_s = 5.0;
-  return bench::run_point(bench.devices(), bench.clock(), req, opt).record();
+  return testing::measure(emulator::TwinConfig{}, req, 5.0);
 }
 
 TEST(ClosedLoopEstimators, HfiHoldsTheLowSpeedRangeAndCostsCurrentAndPower) {
