@@ -121,5 +121,7 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
 std::vector<HistogramBin> histogram_bins(const std::vector<double>& values, double width);
 
 nlohmann::ordered_json to_json(const Analysis& a);
+// One row per curve: MTPA and ME optima, deltas against the reference, position-error summary.
+std::string analysis_curves_csv(const Analysis& a);
 
 }  // namespace synbench::bench

@@ -1,6 +1,8 @@
 // Route handlers of the daemon; see api_routes.hpp and docs/api.md.
 #include "server/http/api_routes.hpp"
 
+#include "server/http/info_routes.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -24,8 +26,8 @@ std::variant<nlohmann::json, Response> parse_json_object(const std::string& body
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(body);
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.what() names the position: "parse error at line 1, column 9: syntax error ..."
+  } catch (const nlohmann::json::exception& e) {
+    // Syntax errors and numbers out of double's range (1e999); e.what() names the position: "parse error at line 1, column 9: syntax error ..."
     std::string what = e.what();
     const auto bracket = what.find("] ");
     if (bracket != std::string::npos) what = what.substr(bracket + 2);
@@ -60,6 +62,13 @@ const char* state_name(drivers::DriveState s) {
 
 Response bad_field(const std::string& field, const std::string& reason) {
   return error_response(400, "bad_field", field + ": " + reason);
+}
+
+template <class Names>
+std::string join(const Names& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + std::string(n);
+  return out;
 }
 
 std::string fmt(double v) {
@@ -104,6 +113,7 @@ nlohmann::json status_json(const BenchStatus& s) {
   j["enabled"] = s.enabled;
   j["stopping"] = s.stopping;
   j["setpoints"] = {{"speed_rpm", s.setpoints.speed_rpm}, {"load_Nm", s.setpoints.load_Nm}, {"angle_deg", s.setpoints.angle_deg}};
+  j["mode"] = {{"estimator", std::string(drivers::name(s.mode.estimator))}, {"pwm", std::string(drivers::name(s.mode.pwm))}};
   if (s.synrm) {
     const auto& t = *s.synrm;
     j["synrm"] = {{"speed_rpm", t.speed_rpm}, {"im_A", t.im_A},     {"id_A", t.id_A},     {"iq_A", t.iq_A},
@@ -169,6 +179,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
   ControlLock* control = &ctx.control;
   constexpr double kMaxLoad_Nm = 10.0;  // beyond the 0.55 kW machine's rating; the supervisor guards current
 
+  add_info_routes(router, *bench);
   router.add({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
               [bench, version](const Request&) {
                 const auto s = bench->status();
@@ -230,6 +241,35 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 return refusal_or_ok(bench->enable(doc["enabled"].get<bool>()), *bench);
               },
               nlohmann::json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
+  router.add({"POST", "/api/bench/mode", Role::operator_,
+              "Choose the estimator and/or PWM scheme manual operation runs with (drives disabled).",
+              [bench, control](const Request& req) {
+                if (!control->claim(req.caller_id)) return locked(*control);
+                auto parsed = parse_json_object(req.body);
+                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                const auto& doc = std::get<nlohmann::json>(parsed);
+                if (auto r = unknown_fields(doc, {"estimator", "pwm"})) return *r;
+                if (doc.empty()) return error_response(400, "bad_field", "give estimator and/or pwm");
+                DriveMode mode = bench->status().mode;
+                if (doc.contains("estimator")) {
+                  const auto& v = doc["estimator"];
+                  const auto e = v.is_string() ? drivers::parse_estimator(v.get<std::string>()) : std::nullopt;
+                  if (!e) return bad_field("estimator", "must be one of " + join(drivers::kEstimatorNames));
+                  mode.estimator = *e;
+                }
+                if (doc.contains("pwm")) {
+                  const auto& v = doc["pwm"];
+                  const auto p = v.is_string() ? drivers::parse_pwm(v.get<std::string>()) : std::nullopt;
+                  if (!p) return bad_field("pwm", "must be one of " + join(drivers::kPwmNames));
+                  mode.pwm = *p;
+                }
+                return refusal_or_ok(bench->set_mode(mode), *bench);
+              },
+              nlohmann::json{{"type", "object"},
+                             {"additionalProperties", false},
+                             {"properties",
+                              {{"estimator", {{"type", "string"}, {"enum", drivers::kEstimatorNames}}},
+                               {"pwm", {{"type", "string"}, {"enum", drivers::kPwmNames}}}}}}});
   router.add({"POST", "/api/bench/setpoints", Role::operator_,
               "Set speed_rpm, load_Nm and/or angle_deg (omitted fields keep their value).",
               [bench, control, max_speed_rpm, kMaxLoad_Nm](const Request& req) {

@@ -35,10 +35,13 @@ class BenchRuntime::Sink final : public bench::SweepSink {
 };
 
 BenchRuntime::BenchRuntime(const emulator::TwinConfig& config, bench::SafetyLimits limits)
-    : config_(config), twin_(std::make_unique<emulator::TwinBench>(config)) {
+    : BenchRuntime(config, limits, make_twin_backend(config)) {}
+
+BenchRuntime::BenchRuntime(const emulator::TwinConfig& config, bench::SafetyLimits limits, std::unique_ptr<BenchBackend> backend)
+    : config_(config), backend_(std::move(backend)) {
   // The sink runs inside supervisor_->tick/estop/reset, always under mutex_.
   supervisor_ = std::make_unique<bench::SafetySupervisor>(
-      twin_->devices(), limits, [this](const std::string& kind, const std::string& message) { event_locked(kind, message); });
+      backend_->devices(), limits, [this](const std::string& kind, const std::string& message) { event_locked(kind, message); });
 }
 
 BenchRuntime::~BenchRuntime() { shutdown(std::chrono::milliseconds(2000)); }
@@ -50,7 +53,7 @@ void BenchRuntime::start() {
 }
 
 void BenchRuntime::event_locked(const std::string& kind, const std::string& message) {
-  events_.push_back({twin_->clock().now_s(), kind, message});
+  events_.push_back({backend_->clock().now_s(), kind, message, ++event_seq_});
   while (events_.size() > kMaxEvents) events_.pop_front();
 }
 
@@ -58,13 +61,13 @@ void BenchRuntime::run() {
   using clock = std::chrono::steady_clock;
   std::unique_lock lock(mutex_);
   const auto t0 = clock::now();
-  const double base_s = twin_->clock().now_s();
+  const double base_s = backend_->clock().now_s();
   auto next = t0;
   while (!quit_) {
     const double target_s = base_s + std::chrono::duration<double>(clock::now() - t0).count();
     // Waiting on the twin's clock advances the simulation to the wall clock.
-    if (target_s > twin_->clock().now_s()) twin_->clock().wait_until(target_s);
-    tick_locked(twin_->clock().now_s());
+    if (target_s > backend_->clock().now_s()) backend_->clock().wait_until(target_s);
+    tick_locked(backend_->clock().now_s());
     next += kTick;
     const auto now = clock::now();
     if (now > next + kTick) {
@@ -75,8 +78,14 @@ void BenchRuntime::run() {
   }
 }
 
+nlohmann::json BenchRuntime::describe_devices() const {
+  std::lock_guard lock(mutex_);
+  return backend_->describe();
+}
+
 void BenchRuntime::tick_locked(double now_s) {
   ++ticks_;
+  backend_->tick(now_s);
   supervisor_->tick(now_s);
   if (engine_) {
     // The engine reads the supervisor's verdict itself: a trip faults the sweep.
@@ -94,7 +103,7 @@ void BenchRuntime::tick_locked(double now_s) {
     const auto& s = supervisor_->synrm();
     const bool slow = s && std::abs(s->speed_rpm) < kStopSpeed_rpm;
     if (slow || now_s - stop_since_s_ > kStopTimeout_s) {
-      auto dev = twin_->devices();
+      auto dev = backend_->devices();
       dev.synrm->enable(false);
       dev.load->enable(false);
       stopping_ = false;
@@ -140,8 +149,8 @@ std::optional<Refusal> BenchRuntime::start_sweep(std::int64_t id, bench::SweepPl
   sweep_sparse_ = plan.mode == bench::SweepMode::adaptive;
   sink_ = std::make_unique<Sink>(*sweep_store_, id);
   bench::SweepBench cal;
-  cal.load_b1_Nms_per_rad = config_.load.b1_Nms_per_rad;
-  engine_ = std::make_unique<bench::SweepEngine>(twin_->devices(), *supervisor_, std::move(plan), std::move(stored), *sink_, cal);
+  cal.load_b1_Nms_per_rad = backend_->load_b1_Nms_per_rad();
+  engine_ = std::make_unique<bench::SweepEngine>(backend_->devices(), *supervisor_, std::move(plan), std::move(stored), *sink_, cal);
   event_locked("sweep", "sweep " + std::to_string(id) + " started");
   return std::nullopt;
 }
@@ -158,7 +167,7 @@ std::optional<Refusal> BenchRuntime::sweep_action(std::int64_t id, const std::st
 }
 
 std::optional<Refusal> BenchRuntime::apply_locked() {
-  auto dev = twin_->devices();
+  auto dev = backend_->devices();
   std::error_code ec;
   if ((ec = dev.synrm->set_angle_deg(setpoints_.angle_deg)) || (ec = dev.synrm->set_speed_rpm(setpoints_.speed_rpm)) ||
       (ec = dev.load->set_torque_Nm(setpoints_.load_Nm)))
@@ -168,7 +177,7 @@ std::optional<Refusal> BenchRuntime::apply_locked() {
 
 std::optional<Refusal> BenchRuntime::enable(bool on) {
   std::lock_guard lock(mutex_);
-  auto dev = twin_->devices();
+  auto dev = backend_->devices();
   if (engine_) return Refusal{409, "sweep_running", "sweep " + std::to_string(sweep_id_) + " drives the bench; abort it first"};
   if (on) {
     if (supervisor_->tripped())
@@ -176,6 +185,8 @@ std::optional<Refusal> BenchRuntime::enable(bool on) {
     if (enabled_ && !stopping_) return std::nullopt;
     stopping_ = false;
     std::error_code ec;
+    if ((ec = dev.synrm->set_estimator(mode_.estimator)) || (ec = dev.synrm->set_pwm(mode_.pwm)))
+      return Refusal{502, "device_error", "setting the drive mode: " + ec.message()};
     // As the point procedure: the load first, at zero torque, then the SynRM with its setpoints.
     if ((ec = dev.load->set_torque_Nm(0.0)) || (ec = dev.load->enable(true)))
       return Refusal{502, "device_error", "enabling the load drive: " + ec.message()};
@@ -188,7 +199,7 @@ std::optional<Refusal> BenchRuntime::enable(bool on) {
   if (!enabled_ || stopping_) return std::nullopt;
   enabled_ = false;
   stopping_ = true;
-  stop_since_s_ = twin_->clock().now_s();
+  stop_since_s_ = backend_->clock().now_s();
   dev.load->set_torque_Nm(0.0);
   dev.synrm->set_speed_rpm(0.0);
   event_locked("stop", "ordered stop requested");
@@ -206,16 +217,25 @@ std::optional<Refusal> BenchRuntime::set_setpoints(const Setpoints& sp) {
   return std::nullopt;
 }
 
+std::optional<Refusal> BenchRuntime::set_mode(const DriveMode& mode) {
+  std::lock_guard lock(mutex_);
+  if (engine_) return Refusal{409, "sweep_running", "sweep " + std::to_string(sweep_id_) + " drives the bench; abort it first"};
+  if (enabled_ || stopping_) return Refusal{409, "bench_enabled", "the drives are enabled; disable them before switching the estimator or PWM"};
+  mode_ = mode;
+  event_locked("mode", "estimator " + std::string(drivers::name(mode.estimator)) + ", pwm " + std::string(drivers::name(mode.pwm)));
+  return std::nullopt;
+}
+
 void BenchRuntime::estop() {
   std::lock_guard lock(mutex_);
-  supervisor_->estop(twin_->clock().now_s(), "E-stop (REST)");
+  supervisor_->estop(backend_->clock().now_s(), "E-stop (REST)");
   enabled_ = false;
   stopping_ = false;
 }
 
 std::optional<Refusal> BenchRuntime::reset() {
   std::lock_guard lock(mutex_);
-  if (auto ec = supervisor_->reset(twin_->clock().now_s()))
+  if (auto ec = supervisor_->reset(backend_->clock().now_s()))
     return Refusal{409, "stop_in_progress", "reset refused: " + ec.message()};
   return std::nullopt;
 }
@@ -223,10 +243,11 @@ std::optional<Refusal> BenchRuntime::reset() {
 BenchStatus BenchRuntime::status() const {
   std::lock_guard lock(mutex_);
   BenchStatus s;
-  s.t_s = twin_->clock().now_s();
+  s.t_s = backend_->clock().now_s();
   s.enabled = enabled_;
   s.stopping = stopping_;
   s.setpoints = setpoints_;
+  s.mode = mode_;
   s.synrm = supervisor_->synrm();
   s.load = supervisor_->load();
   s.phase = supervisor_->phase();
@@ -277,7 +298,7 @@ void BenchRuntime::shutdown(std::chrono::milliseconds timeout) {
   // Whatever happened above, the drives end disabled.
   std::lock_guard lock(mutex_);
   if (engine_) finish_sweep_locked();
-  auto dev = twin_->devices();
+  auto dev = backend_->devices();
   dev.load->enable(false);
   dev.synrm->enable(false);
 }

@@ -1,6 +1,6 @@
-// The daemon's bench: the in-process twin run in real time on a thread of its own. Every 10 ms
-// the twin's virtual clock is advanced to the wall clock's elapsed time and the safety
-// supervisor ticked; HTTP handlers reach the bench only through this class, whose mutex they
+// The daemon's bench: the in-process twin (or a real bench through a BenchBackend) run in real
+// time on a thread of its own. Every 10 ms the bench clock is advanced to the wall clock's
+// elapsed time (the twin's virtual clock is made to follow it) and the safety supervisor ticked; HTTP handlers reach the bench only through this class, whose mutex they
 // share with the bench thread for the few microseconds a command or a status read takes.
 #pragma once
 
@@ -20,8 +20,8 @@
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
 #include "db/store.hpp"
-#include "emulator/twin_bench.hpp"
 #include "emulator/twin_config.hpp"
+#include "server/http/bench_backend.hpp"
 
 namespace synbench::http {
 
@@ -31,9 +31,16 @@ struct Setpoints {
   double angle_deg = 45;
 };
 
+// The drive configuration manual operation runs with (a sweep sets its own per point).
+struct DriveMode {
+  drivers::Estimator estimator = drivers::Estimator::encoder;
+  drivers::Pwm pwm = drivers::Pwm::capwm;
+};
+
 struct BenchEvent {
   double t_s = 0;
   std::string kind, message;
+  std::uint64_t seq = 0;  // 1, 2, 3, ... in order of occurrence: the WebSocket hub sends each once
 };
 
 // The sweep the bench thread runs (or ran last).
@@ -49,6 +56,7 @@ struct BenchStatus {
   bool enabled = false;
   bool stopping = false;  // an ordered stop asked for by disable or shutdown is under way
   Setpoints setpoints;
+  DriveMode mode;
   std::optional<drivers::SynrmTelemetry> synrm;
   std::optional<drivers::LoadTelemetry> load;
   bench::SafetyPhase phase = bench::SafetyPhase::normal;
@@ -70,7 +78,10 @@ class BenchRuntime {
   static constexpr std::chrono::milliseconds kTick{10};
   static constexpr std::size_t kMaxEvents = 50;
 
+  // On the in-process twin.
   BenchRuntime(const emulator::TwinConfig& config, bench::SafetyLimits limits);
+  // On `backend`; `config` still gives the machine's limits the setpoints are checked against.
+  BenchRuntime(const emulator::TwinConfig& config, bench::SafetyLimits limits, std::unique_ptr<BenchBackend> backend);
   ~BenchRuntime();
   BenchRuntime(const BenchRuntime&) = delete;
   BenchRuntime& operator=(const BenchRuntime&) = delete;
@@ -82,12 +93,16 @@ class BenchRuntime {
 
   BenchStatus status() const;
   const emulator::TwinConfig& config() const { return config_; }
+  nlohmann::json describe_devices() const;
 
   // Enabling starts both drives with the current setpoints; disabling is the ordered stop.
   std::optional<Refusal> enable(bool on);
   // Applied at once when enabled, kept for the next enable otherwise. Values are validated by
   // the caller (the REST handler names the field); refused while the supervisor is tripped.
   std::optional<Refusal> set_setpoints(const Setpoints& sp);
+  // Position source and switching scheme for manual operation; refused while the drives are
+  // enabled (the firmware switches only when stopped, as the sweep engine does) or a sweep runs.
+  std::optional<Refusal> set_mode(const DriveMode& mode);
   void estop();
   std::optional<Refusal> reset();
 
@@ -107,7 +122,7 @@ class BenchRuntime {
   std::optional<Refusal> apply_locked();
 
   emulator::TwinConfig config_;
-  std::unique_ptr<emulator::TwinBench> twin_;
+  std::unique_ptr<BenchBackend> backend_;
   std::unique_ptr<bench::SafetySupervisor> supervisor_;
 
   mutable std::mutex mutex_;
@@ -117,7 +132,9 @@ class BenchRuntime {
   bool stopping_ = false;
   double stop_since_s_ = 0;
   Setpoints setpoints_;
+  DriveMode mode_;
   std::uint64_t ticks_ = 0, overruns_ = 0;
+  std::uint64_t event_seq_ = 0;  // seq of the last event
   std::deque<BenchEvent> events_;
   std::unique_ptr<db::Store> sweep_store_;
   std::unique_ptr<Sink> sink_;

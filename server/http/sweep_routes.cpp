@@ -5,7 +5,9 @@
 #include <map>
 #include <string>
 
+#include "bench/analysis.hpp"
 #include "bench/sweep_plan.hpp"
+#include "bench/sweep_presets.hpp"
 #include "db/export.hpp"
 #include "server/http/api_routes.hpp"
 
@@ -42,6 +44,33 @@ std::optional<std::int64_t> sweep_id(const Request& req, Response& error) {
     return std::nullopt;
   }
   return v;
+}
+
+// Every problem of a plan, each at its JSON pointer, as one 400.
+Response bad_plan(const bench::SweepPlanParseResult& plan) {
+  std::string message;
+  for (const auto& e : plan.errors) message += (message.empty() ? "" : "; ") + bench::to_string(e);
+  return error_response(400, "bad_plan", message.empty() ? "the plan does not parse" : message);
+}
+
+// "encoder/capwm" -> a configuration, for ?reference=.
+std::optional<bench::Configuration> parse_configuration_label(const std::string& text) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) return std::nullopt;
+  const auto e = drivers::parse_estimator(text.substr(0, slash));
+  const auto p = drivers::parse_pwm(text.substr(slash + 1));
+  if (!e || !p) return std::nullopt;
+  return bench::Configuration{*e, *p};
+}
+
+// ?format=json|csv, or a 400 naming the field.
+std::optional<std::string> format_of(const Request& req, Response& error) {
+  const auto format = req.query.count("format") ? req.query.at("format") : std::string("json");
+  if (format != "json" && format != "csv") {
+    error = error_response(400, "bad_field", "format: '" + format + "' is not json or csv");
+    return std::nullopt;
+  }
+  return format;
 }
 
 Response db_error(const db::Error& e) {
@@ -98,13 +127,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return *r;
                 auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
-                if (!plan.errors.empty() || !plan.plan) {
-                  // Every problem, each at its JSON pointer.
-                  std::string message;
-                  for (const auto& e : plan.errors) message += (message.empty() ? "" : "; ") + bench::to_string(e);
-                  Response r = error_response(400, "bad_plan", message.empty() ? "the plan does not parse" : message);
-                  return r;
-                }
+                if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 db::SweepMeta meta;
                 meta.name = plan.plan->name.empty() ? "sweep" : plan.plan->name;
                 meta.plan = bench::to_json(*plan.plan);
@@ -138,14 +161,13 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 Response err;
                 const auto id = sweep_id(req, err);
                 if (!id) return err;
-                const auto format = req.query.count("format") ? req.query.at("format") : std::string("json");
-                if (format != "json" && format != "csv")
-                  return error_response(400, "bad_field", "format: '" + format + "' is not json or csv");
+                const auto format = format_of(req, err);
+                if (!format) return err;
                 if (auto s = db->get_sweep(*id); !s) return db_error(s.error());
                 auto rows = db->points(*id);
                 if (!rows) return db_error(rows.error());
                 Response r;
-                if (format == "csv") {
+                if (*format == "csv") {
                   r.content_type = "text/csv; charset=utf-8";
                   r.body = db::points_to_csv(*rows);
                 } else {
@@ -153,6 +175,69 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 }
                 return r;
               }});
+  router.add({"GET", "/api/sweeps/{id}/analysis", Role::viewer,
+              "Analysis of a sweep's stored points (docs/analysis.md): JSON, or the curves as CSV with ?format=csv; "
+              "?reference=ESTIMATOR/PWM (default encoder/capwm) for the deltas.",
+              [db](const Request& req) {
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                const auto format = format_of(req, err);
+                if (!format) return err;
+                bench::AnalysisOptions options;
+                if (req.query.count("reference")) {
+                  const auto ref = parse_configuration_label(req.query.at("reference"));
+                  if (!ref)
+                    return error_response(400, "bad_field", "reference: '" + req.query.at("reference") +
+                                                                "' is not ESTIMATOR/PWM (e.g. encoder/capwm)");
+                  options.reference = *ref;
+                }
+                if (auto s = db->get_sweep(*id); !s) return db_error(s.error());
+                auto rows = db->points(*id);
+                if (!rows) return db_error(rows.error());
+                std::vector<bench::PointRecord> records;
+                records.reserve(rows->size());
+                for (const auto& row : *rows) records.push_back(row.record);
+                const auto analysis = bench::analyze(records, options);
+                Response r;
+                if (*format == "csv") {
+                  r.content_type = "text/csv; charset=utf-8";
+                  r.body = bench::analysis_curves_csv(analysis);
+                } else {
+                  r.body = bench::to_json(analysis).dump();
+                }
+                return r;
+              }});
+  router.add({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
+              [](const Request&) {
+                nlohmann::json out = nlohmann::json::array();
+                const auto add = [&out](std::string_view name, const char* description, const bench::SweepPlan& p) {
+                  out.push_back({{"name", std::string(name)},
+                                 {"description", description},
+                                 {"plan", nlohmann::json::parse(bench::to_json(p).dump())},
+                                 {"estimate", nlohmann::json::parse(bench::to_json(bench::estimate(p)).dump())}});
+                };
+                add(bench::kThesisGridPreset,
+                    "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, encoder/CAPWM",
+                    bench::thesis_grid_plan());
+                add(bench::kIecPreset, "IEC 61800-9-2 drive operating points (speed %, torque %) at 40..76 deg step 2",
+                    bench::iec_61800_9_2_plan());
+                return json_response(200, out);
+              }});
+  router.add({"POST", "/api/sweeps/estimate", Role::viewer,
+              "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
+              [](const Request& req) {
+                auto parsed = parse_json_object(req.body);
+                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
+                if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
+                const auto e = bench::estimate(*plan.plan);
+                nlohmann::json out = nlohmann::json::parse(bench::to_json(e).dump());
+                out["duration_s"] = e.bench_time_s;
+                out["plan"] = nlohmann::json::parse(bench::to_json(*plan.plan).dump());
+                return json_response(200, out);
+              },
+              nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
 }
 
 }  // namespace synbench::http

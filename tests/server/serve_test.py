@@ -103,7 +103,13 @@ def main():
         # Every route of the table, enumerated from the document.
         for method, path, role in routes:
             concrete = re.sub(r"\{[^}]+\}", "1", path)
-            if method != "GET":
+            if method != "GET" and role == "viewer":
+                # Validation without side effects (POST /api/sweeps/estimate): any token reads.
+                s, _, _ = d.request(method, concrete, body={})
+                check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
+                s, _, _ = d.request(method, concrete, body={}, token=viewer)
+                check(s in (200, 400), "%s %s with viewer -> answered (got %d)" % (method, path, s))
+            elif method != "GET":
                 check(role == "operator", "%s %s needs operator" % (method, path))
                 s, data, r = d.request(method, concrete, body={})
                 check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
@@ -134,6 +140,49 @@ def main():
         lines = data.decode().splitlines()
         check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("point_index")
               and len(lines) == 3, "points as CSV")
+        # Analysis of the stored sweep, JSON and CSV.
+        s, data, _ = d.request("GET", "/api/sweeps/1/analysis", token=viewer)
+        an = json.loads(data)
+        check(s == 200 and an["schema"] == "synbench.analysis/1", "analysis as JSON (%s)" % data[:200])
+        curves = an["curves"]["entries"]
+        check(len(curves) == 1 and curves[0]["speed_rpm"] == 500 and 48 <= curves[0]["mtpa"]["angle_deg"] <= 52,
+              "analysis: one curve at 500 rpm, MTPA within the two angles measured (%s)" % curves[:1])
+        s, data, r = d.request("GET", "/api/sweeps/1/analysis?format=csv", token=viewer)
+        lines = data.decode().splitlines()
+        check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("estimator,pwm,speed_rpm")
+              and len(lines) == 2 and lines[1].startswith("encoder,capwm,500,1,2,"), "analysis as CSV (%s)" % lines[:2])
+        s, data, _ = d.request("GET", "/api/sweeps/1/analysis?reference=nothing", token=viewer)
+        check(s == 400 and error_of(data)[1].startswith("reference"), "bad reference -> 400 naming reference")
+        s, data, _ = d.request("GET", "/api/sweeps/1/analysis?reference=ekf-rs/aspwm", token=viewer)
+        check(s == 200 and json.loads(data)["deltas"]["reference"]["estimator"] == "ekf-rs", "analysis with another reference")
+        # Presets and estimates.
+        s, data, _ = d.request("GET", "/api/presets", token=viewer)
+        presets = {p["name"]: p for p in json.loads(data)}
+        check(s == 200 and set(presets) == {"thesis-grid", "iec-61800-9-2"}, "presets listed")
+        check(presets["thesis-grid"]["estimate"]["points"] == 5 * 7 * 19 * 8 - 2 * 3 * 7 * 19,
+              "thesis grid: 5 x 7 x 19 points per configuration, EEMF variants from 500 rpm (%s)"
+              % presets["thesis-grid"]["estimate"]["points"])
+        s, data, _ = d.request("POST", "/api/sweeps/estimate", token=viewer,
+                               body={"dimensions": {"speed_rpm": [300, 600], "load_Nm": [1, 2], "angle_deg": {"from": 44, "to": 64, "step": 10}}})
+        est = json.loads(data)
+        check(s == 200 and est["points"] == 12 and est["duration_s"] > 12 and est["plan"]["dimensions"]["angle_deg"] == [44, 54, 64],
+              "estimate of a 2 x 2 x 3 plan (%s)" % data[:200])
+        s, data, _ = d.request("POST", "/api/sweeps/estimate", token=viewer, body={"dimensions": {"speed_rpm": {"from": 1, "to": 2, "step": 0}}})
+        check(s == 400 and error_of(data)[0] == "bad_plan" and "/dimensions/speed_rpm" in error_of(data)[1], "bad estimate -> 400 at the pointer")
+        # Who am I, estimators, devices, profiles.
+        s, data, _ = d.request("GET", "/api/whoami", token=viewer)
+        check(s == 200 and json.loads(data)["role"] == "viewer" and viewer not in data.decode(), "whoami as viewer")
+        s, data, _ = d.request("GET", "/api/whoami", token=op)
+        check(json.loads(data)["role"] == "operator", "whoami as operator")
+        s, data, _ = d.request("GET", "/api/estimators", token=viewer)
+        est = {e["name"]: e for e in json.loads(data)}
+        check(len(est) == 7 and not est["encoder"]["sensorless"] and est["eemf-lut"]["min_speed_rpm"] == 500, "estimators listed")
+        s, data, _ = d.request("GET", "/api/devices", token=viewer)
+        check(s == 200 and {x["role"] for x in json.loads(data)} >= {"synrm", "load", "meter"}
+              and json.loads(data)[0]["backend"] == "twin", "devices of the twin")
+        s, data, _ = d.request("GET", "/api/profiles", token=viewer)
+        profs = json.loads(data)
+        check(s == 200 and len(profs) == 3 and all(p["valid"] for p in profs), "default profiles listed, valid")
         tiny = {"name": "rest", "window_s": 0.5, "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}}
         s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
         created = json.loads(data)
@@ -231,6 +280,13 @@ def main():
             check(resp.status == 200, "keep-alive request")
         conn.close()
 
+        # Manual mode: estimator and PWM, refused while enabled.
+        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "ekf-rs", "pwm": "aspwm"}, token=op)
+        check(s == 200 and json.loads(data)["mode"] == {"estimator": "ekf-rs", "pwm": "aspwm"}, "mode -> ekf-rs/aspwm")
+        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "magic"}, token=op)
+        check(s == 400 and error_of(data)[1].startswith("estimator"), "unknown estimator -> 400 naming estimator")
+        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "encoder", "pwm": "capwm"}, token=op)
+        check(s == 200, "mode back to encoder/capwm")
         # The twin follows the operator's setpoint in real time.
         s, _, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 400, "load_Nm": 0.5, "angle_deg": 50}, token=op)
         check(s == 200, "setpoints as operator -> 200")
@@ -246,6 +302,8 @@ def main():
                 break
             time.sleep(0.2)
         check(abs(speed - 400) < 20, "twin speed follows the setpoint (%.1f rpm)" % speed)
+        s, data, _ = d.request("POST", "/api/bench/mode", body={"pwm": "aspwm"}, token=op)
+        check(s == 409 and error_of(data)[0] == "bench_enabled", "mode change refused while enabled")
         s, data, _ = d.request("GET", "/metrics")
         check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
 
