@@ -1,7 +1,26 @@
 #!/usr/bin/env bash
 # Configures and builds one CMake preset (default: "default"): scripts/build.sh [preset]
+# Also builds the web dashboard into web/dist (served by synbench serve): `npm ci` only when
+# web/package-lock.json changed since the last install, `npm run build` only when a source changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-default}
+
+if command -v npm >/dev/null 2>&1; then
+  (
+    cd web
+    stamp=node_modules/.synbench-lock
+    if [ ! -f "$stamp" ] || ! cmp -s package-lock.json "$stamp"; then
+      npm ci --no-audit --no-fund --loglevel=error
+      cp package-lock.json "$stamp"
+    fi
+    if [ ! -f dist/index.html ] || [ -n "$(find index.html vite.config.js package-lock.json src -newer dist/index.html 2>/dev/null | head -1)" ]; then
+      npm run --silent build -- --logLevel warn
+    fi
+  )
+else
+  echo "build: npm not found, the web dashboard (web/dist) is not built (scripts/install-deps.sh installs it)" >&2
+fi
+
 cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" -- -j"$(nproc)"

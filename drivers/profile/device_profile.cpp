@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <tuple>
@@ -455,7 +456,11 @@ ProfileParseResult load_device_profile(const std::filesystem::path& file) {
   return parse_device_profile(doc);
 }
 
-std::filesystem::path default_profile_dir() { return SYNBENCH_PROFILE_DIR; }
+std::filesystem::path default_profile_dir() {
+  // An installed synbench (docker/, a package) finds them where it installed them.
+  if (const char* env = std::getenv("SYNBENCH_PROFILE_DIR"); env && *env) return env;
+  return SYNBENCH_PROFILE_DIR;
+}
 
 std::filesystem::path default_profile_path(DeviceKind kind) {
   return default_profile_dir() / (std::string(name(kind)) + ".json");

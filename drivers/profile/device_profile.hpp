@@ -92,7 +92,8 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc);
 // path "" with the file name in the reason.
 ProfileParseResult load_device_profile(const std::filesystem::path& file);
 
-// drivers/profiles/ of the source tree, where the profiles of synbench's own firmware live.
+// Where the profiles of synbench's own firmware live: $SYNBENCH_PROFILE_DIR when set (an installed
+// synbench: share/synbench/profiles), else drivers/profiles/ of the source tree.
 std::filesystem::path default_profile_dir();
 // default_profile_dir() / "<kind>.json"
 std::filesystem::path default_profile_path(DeviceKind kind);

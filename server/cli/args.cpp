@@ -7,7 +7,7 @@
 namespace synbench::cli {
 
 Args::Args(const std::vector<std::string>& argv, std::set<std::string> switches,
-           std::set<std::string> valued) {
+           std::set<std::string> valued, std::set<std::string> repeatable) {
   for (std::size_t i = 0; i < argv.size(); ++i) {
     const std::string& a = argv[i];
     if (a.rfind("--", 0) != 0) {
@@ -24,10 +24,14 @@ Args::Args(const std::vector<std::string>& argv, std::set<std::string> switches,
     if (switches.count(name)) {
       if (inline_value) throw UsageError(name, "takes no value");
       switches_.insert(name);
-    } else if (valued.count(name)) {
+    } else if (valued.count(name) || repeatable.count(name)) {
       if (!inline_value) {
         if (i + 1 >= argv.size()) throw UsageError(name, "needs a value");
         value = argv[++i];
+      }
+      if (repeatable.count(name)) {
+        repeated_[name].push_back(value);
+        continue;
       }
       if (values_.count(name)) throw UsageError(name, "given twice");
       values_[name] = value;
@@ -43,6 +47,11 @@ std::optional<std::string> Args::text(const std::string& flag) const {
   auto it = values_.find(flag);
   if (it == values_.end()) return std::nullopt;
   return it->second;
+}
+
+std::vector<std::string> Args::all(const std::string& flag) const {
+  auto it = repeated_.find(flag);
+  return it == repeated_.end() ? std::vector<std::string>{} : it->second;
 }
 
 std::optional<double> Args::number(const std::string& flag) const {

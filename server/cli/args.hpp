@@ -19,18 +19,22 @@ class UsageError : public std::runtime_error {
 
 class Args {
  public:
-  // `switches` take no value; `valued` take one. Anything else is an unknown flag.
+  // `switches` take no value; `valued` take one; `repeatable` take one each time they are
+  // given. Anything else is an unknown flag.
   Args(const std::vector<std::string>& argv, std::set<std::string> switches,
-       std::set<std::string> valued);
+       std::set<std::string> valued, std::set<std::string> repeatable = {});
 
   bool has(const std::string& flag) const;
   std::optional<std::string> text(const std::string& flag) const;
   std::optional<double> number(const std::string& flag) const;
+  // Every value of a repeatable flag, in order.
+  std::vector<std::string> all(const std::string& flag) const;
   const std::vector<std::string>& positional() const { return positional_; }
 
  private:
   std::set<std::string> switches_;
   std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> repeated_;
   std::vector<std::string> positional_;
 };
 

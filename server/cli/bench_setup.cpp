@@ -5,11 +5,15 @@
 #include "drivers/real_time_clock.hpp"
 #include "emulator/modbus/twin_register_bus.hpp"
 #include "emulator/modbus/twin_service.hpp"
+#include "server/cli/args.hpp"
+#include "server/http/bench_backend.hpp"
 
 namespace synbench::cli {
 
 ConfiguredBench::ConfiguredBench(const drivers::BenchConfig& config, drivers::BenchProfiles profiles,
-                                 const emulator::TwinConfig& twin) {
+                                 const emulator::TwinConfig& twin)
+    : config_(config),
+      profile_names_{profiles.synrm_drive.name, profiles.load_drive.name, profiles.vfc_meter.name} {
   using drivers::LinkTransport;
   if (config.on_twin()) {
     // The in-process twin serves the config's own profiles, so a user's profile can be tried
@@ -44,11 +48,67 @@ std::string ConfiguredBench::describe() const {
   return s;
 }
 
+nlohmann::json ConfiguredBench::describe_devices() const {
+  nlohmann::json out = nlohmann::json::array();
+  const std::pair<const char*, const drivers::DeviceConfig*> devices[] = {
+      {"synrm", &config_.synrm_drive}, {"load", &config_.load_drive}, {"meter", &config_.vfc_meter}};
+  const char* kinds[] = {"synrm_drive", "load_drive", "vfc_meter"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& d = *devices[i].second;
+    const auto& link = config_.links.at(d.link);
+    const bool twin = link.transport == drivers::LinkTransport::twin;
+    out.push_back({{"role", devices[i].first},
+                   {"kind", kinds[i]},
+                   {"backend", twin ? "twin-registers" : "modbus"},
+                   {"link", buses_.at(d.link)->name()},
+                   {"profile", profile_names_[i]},
+                   {"profile_file", d.profile.string()}});
+  }
+  return out;
+}
+
 std::string ConfiguredBench::link_errors() const {
   std::string s;
   for (const auto& [name, bus] : buses_)
     if (!bus->last_error().empty()) s += "  " + bus->last_error() + "\n";
   return s;
+}
+
+LoadedBench load_bench_or_throw(const std::string& file, const std::string& flag) {
+  drivers::BenchConfigResult r = drivers::load_bench_config(file);
+  std::vector<drivers::ProfileError> errors = r.errors;
+  std::optional<drivers::BenchProfiles> profiles;
+  if (r.config) profiles = drivers::load_bench_profiles(*r.config, errors);
+  if (!errors.empty() || !profiles) {
+    std::string what;
+    for (const auto& e : errors) what += (what.empty() ? "" : "; ") + e.path + ": " + e.reason;
+    throw UsageError(flag, file + ": " + what);
+  }
+  return {std::move(*r.config), std::move(*profiles)};
+}
+
+namespace {
+
+class ConfiguredBackend final : public http::BenchBackend {
+ public:
+  ConfiguredBackend(LoadedBench b, const emulator::TwinConfig& twin, double b1)
+      : bench_(b.config, std::move(b.profiles), twin), b1_(b1) {}
+  drivers::BenchDevices devices() override { return bench_.bench().devices(); }
+  drivers::Clock& clock() override { return bench_.bench().clock(); }
+  void tick(double now_s) override { bench_.bench().tick(now_s); }
+  nlohmann::json describe() const override { return bench_.describe_devices(); }
+  double load_b1_Nms_per_rad() const override { return b1_; }
+
+ private:
+  ConfiguredBench bench_;
+  double b1_;
+};
+
+}  // namespace
+
+std::unique_ptr<http::BenchBackend> make_configured_backend(LoadedBench bench, const emulator::TwinConfig& twin,
+                                                            double load_b1_Nms_per_rad) {
+  return std::make_unique<ConfiguredBackend>(std::move(bench), twin, load_b1_Nms_per_rad);
 }
 
 }  // namespace synbench::cli

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <map>
+
+#include <nlohmann/json.hpp>
 #include <memory>
 #include <string>
 
@@ -15,7 +17,19 @@ namespace synbench::emulator {
 class TwinService;
 }
 
+namespace synbench::http {
+class BenchBackend;
+}
+
 namespace synbench::cli {
+
+// A bench config file and the profiles it names, loaded and checked; every problem is reported
+// in one UsageError naming `flag` (what `point --bench` and `serve --bench` share).
+struct LoadedBench {
+  drivers::BenchConfig config;
+  drivers::BenchProfiles profiles;
+};
+LoadedBench load_bench_or_throw(const std::string& file, const std::string& flag);
 
 class ConfiguredBench {
  public:
@@ -31,12 +45,21 @@ class ConfiguredBench {
   std::string describe() const;
   // The last error of each link that had one, one per line.
   std::string link_errors() const;
+  // The devices as GET /api/devices lists them.
+  nlohmann::json describe_devices() const;
 
  private:
+  drivers::BenchConfig config_;
+  std::string profile_names_[3];
   std::unique_ptr<emulator::TwinService> twin_;
   std::map<std::string, std::unique_ptr<drivers::RegisterBus>> buses_;
   std::unique_ptr<drivers::Clock> clock_;
   std::unique_ptr<drivers::ProfileBench> bench_;
 };
+
+// The daemon's bench on a bench config: ConfiguredBench behind the runtime's BenchBackend.
+// `load_b1_Nms_per_rad`: the load machine's friction the sweep engine uses for shaft power.
+std::unique_ptr<http::BenchBackend> make_configured_backend(LoadedBench bench, const emulator::TwinConfig& twin,
+                                                            double load_b1_Nms_per_rad);
 
 }  // namespace synbench::cli

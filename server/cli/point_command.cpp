@@ -134,15 +134,9 @@ int point_command(const std::vector<std::string>& argv) {
       config.sim.seed_int = static_cast<int>(*seed);
     }
     if (auto file = a.text("--bench")) {
-      drivers::BenchConfigResult r = drivers::load_bench_config(*file);
-      std::vector<drivers::ProfileError> errors = r.errors;
-      if (r.config) profiles = drivers::load_bench_profiles(*r.config, errors);
-      if (!errors.empty()) {
-        std::string what;
-        for (const auto& e : errors) what += (what.empty() ? "" : "; ") + e.path + ": " + e.reason;
-        throw UsageError("--bench", *file + ": " + what);
-      }
-      bench_config = r.config;
+      auto loaded = load_bench_or_throw(*file, "--bench");
+      bench_config = std::move(loaded.config);
+      profiles = std::move(loaded.profiles);
       if (!bench_config->on_twin())
         for (const char* flag : {"--config", "--seed", "--udc-V", "--temp-C"})
           if (a.text(flag))

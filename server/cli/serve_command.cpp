@@ -1,90 +1,94 @@
-// `synbench serve`: the daemon. REST on one port (server/http/), the in-process twin running in
-// real time under the safety supervisor, bearer tokens from the data directory. SIGINT/SIGTERM
+// `synbench serve`: the daemon. REST, WebSocket and the dashboard on one port (server/http/), the
+// in-process twin (or a bench config's drives) in real time under the safety supervisor, bearer
+// tokens from the data directory. SIGINT/SIGTERM
 // bring the bench to its ordered stop and exit 0.
 #include <sys/stat.h>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include "db/store.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
+#include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
+#include "server/cli/serve_options.hpp"
 #include "server/http/api_routes.hpp"
 #include "server/http/bench_runtime.hpp"
 #include "server/http/http_server.hpp"
 #include "server/http/router.hpp"
 #include "server/http/sweep_routes.hpp"
 #include "server/http/tokens.hpp"
+#include "server/http/ws_hub.hpp"
 #include "synbench/version.hpp"
 
 namespace synbench::cli {
 
 const char* const kServeHelp = R"(usage: synbench serve [--listen HOST:PORT] [--data-dir DIR] [--config FILE]
+                      [--twin-config FILE] [--bench FILE] [--web-dir DIR]
+                      [--allow-host NAME:PORT]... [--allow-origin ORIGIN]...
 
-Runs the synbench daemon: the REST API (docs/api.md; OpenAPI document at /api/openapi.json,
-Prometheus metrics at /metrics) over the bench's twin, in-process and in real time, under the
-safety supervisor. Prints "listening on http://HOST:PORT" once ready.
+Runs the synbench daemon on one port: the REST API (docs/api.md; OpenAPI document at
+/api/openapi.json, Prometheus metrics at /metrics), the WebSocket /ws (telemetry, sweep
+progress, events) and the web dashboard at /. The bench is the in-process twin in real time,
+or the drives of a bench config (--bench), under the safety supervisor. Prints
+"listening on http://HOST:PORT" once ready.
 
-  --listen HOST:PORT   address to listen on (default 127.0.0.1:8080; port 0 picks a free one).
-                       Requests must name it in their Host header (localhost equivalents are
-                       accepted for a loopback address)
-  --data-dir DIR       the daemon's directory (default ./synbench-data, created 0700): tokens.json
-                       holds the tokens' SHA-256 digests, synbench.db the sweeps (add some
-                       with `synbench sweep PLAN --db DIR/synbench.db`). On first start an
-                       operator token is created, printed once on stderr and written to
-                       DIR/operator.token (0600)
-  --config FILE        twin config JSON (docs/emulator-config.md)
+Each setting comes from its flag, else its environment variable, else the config file, else
+the default (docs/deployment.md):
+
+  --listen HOST:PORT   SYNBENCH_LISTEN, "listen": address to listen on (default 127.0.0.1:8080;
+                       port 0 picks a free one). Requests must name it in their Host header
+                       (localhost equivalents are accepted for a loopback address)
+  --data-dir DIR       SYNBENCH_DATA_DIR, "data_dir": the daemon's directory (default
+                       ./synbench-data, created 0700): tokens.json holds the tokens' SHA-256
+                       digests, synbench.db the sweeps. On first start an operator token is
+                       created, printed once on stderr and written to DIR/operator.token (0600)
+  --config FILE        SYNBENCH_CONFIG: the daemon config file (JSON; keys listen, data_dir,
+                       twin, bench, web_dir, allow_hosts, allow_origins; paths relative to it)
+  --twin-config FILE   SYNBENCH_TWIN_CONFIG, "twin": the twin config (docs/emulator-config.md);
+                       its firmware limits also bound the setpoints with --bench
+  --bench FILE         SYNBENCH_BENCH, "bench": a bench config (docs/bench-config.md): the real
+                       drives over Modbus RTU/TCP, or `synbench emulate`, instead of the twin
+  --web-dir DIR        SYNBENCH_WEB_DIR, "web_dir": the web dashboard's built files, served at /
+                       (default: the source tree's web/dist)
+  --allow-host NAME:PORT
+                       SYNBENCH_ALLOW_HOSTS (comma-separated), "allow_hosts": a Host header value
+                       accepted besides the listen address (the name a proxy or a published
+                       container port is reached by); repeatable
+  --allow-origin ORIGIN
+                       SYNBENCH_ALLOW_ORIGINS (comma-separated), "allow_origins": a browser origin
+                       (scheme://host[:port]) allowed to open /ws besides http:// + an allowed
+                       Host; repeatable
   --help               this text
 
 More tokens: synbench token create --role viewer|operator --data-dir DIR
 exit status: 0 stopped by SIGINT/SIGTERM, 1 could not start, 2 bad input
 )";
 
-namespace {
-
-void parse_listen(const std::string& text, std::string& host, std::uint16_t& port) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
-    throw UsageError("--listen", "'" + text + "' is not HOST:PORT");
-  host = text.substr(0, colon);
-  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
-  const std::string p = text.substr(colon + 1);
-  char* end = nullptr;
-  const long v = std::strtol(p.c_str(), &end, 10);
-  if (end != p.c_str() + p.size() || v < 0 || v > 65535) throw UsageError("--listen", "'" + p + "' is not a port (0..65535)");
-  port = static_cast<std::uint16_t>(v);
-}
-
-}  // namespace
-
 int serve_command(const std::vector<std::string>& argv) {
-  std::string host = "127.0.0.1";
-  std::uint16_t port = 8080;
-  std::filesystem::path data_dir = "synbench-data";
-  emulator::TwinConfig config;
-  try {
-    Args a(argv, {"--help"}, {"--listen", "--data-dir", "--config"});
-    if (a.has("--help")) {
+  for (const auto& a : argv)
+    if (a == "--help") {
       std::cout << kServeHelp;
       return 0;
     }
-    if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
-    if (auto l = a.text("--listen")) parse_listen(*l, host, port);
-    if (auto d = a.text("--data-dir")) {
-      if (d->empty()) throw UsageError("--data-dir", "needs a directory");
-      data_dir = *d;
-    }
-    if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+  ServeOptions options;
+  std::optional<LoadedBench> real_bench;
+  try {
+    options = parse_serve_options(argv, process_env(), SYNBENCH_DEFAULT_WEB_DIR);
+    if (options.bench) real_bench = load_bench_or_throw(options.bench->string(), "--bench");
   } catch (const UsageError& e) {
     std::cerr << "synbench serve: " << e.what() << "\n";
     return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "synbench serve: --config: " << e.what() << "\n";
-    return 2;
   }
+  const std::string& host = options.listen_host;
+  const std::uint16_t port = options.listen_port;
+  const std::filesystem::path& data_dir = options.data_dir;
+  const emulator::TwinConfig& config = options.twin;
 
   std::error_code ec;
   std::filesystem::create_directories(data_dir, ec);
@@ -118,16 +122,39 @@ int serve_command(const std::vector<std::string>& argv) {
     return 1;
   }
 
-  http::BenchRuntime bench(config, bench::SafetyLimits{});
+  std::unique_ptr<http::BenchBackend> backend;
+  std::string bench_what = "the in-process twin";
+  if (real_bench) {
+    bench_what = "the bench of " + options.bench->string();
+    backend = make_configured_backend(std::move(*real_bench), config, config.load.b1_Nms_per_rad);
+  } else {
+    backend = http::make_twin_backend(config);
+  }
+  http::BenchRuntime bench(config, bench::SafetyLimits{}, std::move(backend));
   http::HttpMetrics metrics;
   http::Router router([&tokens](std::string_view t) { return tokens.authenticate(t); });
   http::ControlLock control;
   http::add_api_routes(router, {bench, control, metrics, synbench::kVersion});
-  http::add_sweep_routes(router, *store, bench, control, data_dir / "synbench.db", nlohmann::ordered_json::parse(emulator::to_json(config).dump()));
+  // Stored with every sweep created here: the twin's config, or the bench config of the drives.
+  nlohmann::ordered_json bench_meta = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+  if (options.bench) {
+    std::ifstream in(*options.bench);
+    bench_meta = {{"bench_file", options.bench->string()},
+                  {"bench", nlohmann::ordered_json::parse(in, nullptr, false)},
+                  {"devices", nlohmann::ordered_json::parse(bench.describe_devices().dump())}};
+  }
+  http::add_sweep_routes(router, *store, bench, control, data_dir / "synbench.db", bench_meta);
 
   boost::asio::io_context io(1);
   http::HttpServer server(io, router, http::ServerLimits{},
                           [&metrics](const std::string&, const std::string&, int status) { metrics.count(status); });
+  // The dashboard's files and the WebSocket hub (telemetry, sweep, events) on the same port.
+  server.set_web_dir(options.web_dir);
+  server.set_extra_hosts(options.allow_hosts);
+  auto hub = std::make_shared<http::WsHub>(io, bench, router, [&tokens](std::string_view t) { return tokens.authenticate(t); },
+                                           synbench::kVersion);
+  server.set_websocket(hub, options.allow_origins);
+  hub->start();
   if (auto e = server.listen(host, port)) {
     std::cerr << "synbench serve: cannot listen on " << host << ":" << port << ": " << e.message() << "\n";
     return 1;
@@ -139,11 +166,13 @@ int serve_command(const std::vector<std::string>& argv) {
     if (e) return;
     std::cerr << "synbench serve: signal " << sig << ": ordered stop\n";
     server.close();
+    hub->stop();
     bench.shutdown();
     io.stop();
   });
   const bool v6 = host.find(':') != std::string::npos;
   std::cout << "listening on http://" << (v6 ? "[" + host + "]" : host) << ":" << server.port() << std::endl;
+  std::cerr << "synbench serve: bench: " << bench_what << "\n";
   io.run();
   bench.shutdown();
   std::cerr << "synbench serve: stopped\n";

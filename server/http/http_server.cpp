@@ -8,6 +8,11 @@
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/websocket/rfc6455.hpp>
+
+#include "server/http/static_files.hpp"
+#include "server/http/ws_hub.hpp"
+#include "server/http/ws_session.hpp"
 
 namespace synbench::http {
 
@@ -28,12 +33,28 @@ std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_
   return out;
 }
 
+std::set<std::string> allowed_origins(const std::set<std::string>& hosts, const std::vector<std::string>& extra) {
+  std::set<std::string> out;
+  auto lower = [](std::string s) {
+    for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    return s;
+  };
+  for (const auto& h : hosts) out.insert("http://" + lower(h));
+  for (const auto& o : extra) out.insert(lower(o));
+  return out;
+}
+
 struct HttpServer::Shared {
   Shared(const Router& r, ServerLimits l, Observer o) : router(r), limits(l), observer(std::move(o)) {}
   const Router& router;
   ServerLimits limits;
   Observer observer;
   std::set<std::string> hosts;
+  std::optional<StaticFiles> files;
+  std::shared_ptr<WsHub> hub;
+  std::vector<std::string> extra_origins;
+  std::vector<std::string> extra_hosts;
+  std::set<std::string> origins;
   std::atomic<bool> closing{false};
   std::atomic<std::size_t> connections{0};
 };
@@ -52,6 +73,18 @@ std::string lower(std::string s) {
   for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
   return s;
 }
+
+// The REST router's share of the paths; everything else but /ws is the dashboard's.
+bool routed(const std::string& path) {
+  return path == "/api" || path.rfind("/api/", 0) == 0 || path == "/metrics";
+}
+
+// Counts a connection handed over to a WebSocket session for as long as that session lives.
+struct ConnectionSlot {
+  explicit ConnectionSlot(std::shared_ptr<HttpServer::Shared> s) : shared(std::move(s)) { ++shared->connections; }
+  ~ConnectionSlot() { --shared->connections; }
+  std::shared_ptr<HttpServer::Shared> shared;
+};
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
@@ -104,14 +137,32 @@ class Session : public std::enable_shared_from_this<Session> {
     const std::string host(req[bhttp::field::host]);
     const std::string method(req.method_string());
     const std::string target(req.target());
+    const std::string path = target.substr(0, target.find('?'));
     Response r;
     if (!shared_->hosts.count(lower(host))) {
       r = error_response(403, "host_not_allowed", "the Host header must name the listen address");
-    } else {
+    } else if (path == "/ws" && shared_->hub) {
+      const std::string origin(req[bhttp::field::origin]);
+      if (!beast::websocket::is_upgrade(req)) {
+        r = error_response(426, "upgrade_required", "/ws is a WebSocket endpoint (docs/api.md)");
+        r.headers.emplace_back("Upgrade", "websocket");
+      } else if (req.count(bhttp::field::origin) && !shared_->origins.count(lower(origin))) {
+        // A browser always sends Origin: a page from another site must not reach the bench with
+        // a token it got hold of. Clients that are not browsers send none.
+        r = error_response(403, "origin_not_allowed", "the Origin header is not an allowed origin (see --allow-origin)");
+      } else {
+        if (shared_->observer) shared_->observer(method, path, 101);
+        return upgrade(std::move(req));
+      }
+    } else if (routed(path) || !shared_->files) {
       const auto auth = req[bhttp::field::authorization];
       r = shared_->router.dispatch(method, target, std::string_view(auth.data(), auth.size()), std::move(req.body()));
+    } else {
+      // The dashboard's files need no token: the page signs in itself.
+      const auto inm = req[bhttp::field::if_none_match];
+      r = shared_->files->serve(method, target, std::string_view(inm.data(), inm.size()));
     }
-    if (shared_->observer) shared_->observer(method, target.substr(0, target.find('?')), r.status);
+    if (shared_->observer) shared_->observer(method, path, r.status);
     auto res = std::make_shared<bhttp::response<bhttp::string_body>>(static_cast<bhttp::status>(r.status), req.version());
     res->set(bhttp::field::server, "synbench");
     res->set(bhttp::field::content_type, r.content_type);
@@ -123,6 +174,12 @@ class Session : public std::enable_shared_from_this<Session> {
     res->prepare_payload();
     if (req.method() == bhttp::verb::head) res->body().clear();  // Content-Length stays that of GET
     write(res);
+  }
+
+  // The connection leaves this session for a WebSocket session, which answers 101 itself.
+  void upgrade(bhttp::request<bhttp::string_body> req) {
+    auto slot = std::make_shared<ConnectionSlot>(shared_);
+    std::make_shared<WsSession>(stream_.release_socket(), shared_->hub, std::move(slot))->run(std::move(req));
   }
 
   void send_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
@@ -233,8 +290,23 @@ std::error_code HttpServer::listen(const std::string& host, std::uint16_t port) 
   if (auto e = listener_->open(tcp::endpoint(addr, port))) return e;
   port_ = listener_->port();
   shared_->hosts = allowed_hosts(host, port_);
+  shared_->hosts.insert(shared_->extra_hosts.begin(), shared_->extra_hosts.end());
+  shared_->origins = allowed_origins(shared_->hosts, shared_->extra_origins);
   listener_->run();
   return {};
+}
+
+void HttpServer::set_extra_hosts(std::vector<std::string> hosts) {
+  for (auto& h : hosts)
+    for (char& c : h) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  shared_->extra_hosts = std::move(hosts);
+}
+
+void HttpServer::set_web_dir(std::filesystem::path dir) { shared_->files.emplace(std::move(dir)); }
+
+void HttpServer::set_websocket(std::shared_ptr<WsHub> hub, std::vector<std::string> extra_origins) {
+  shared_->hub = std::move(hub);
+  shared_->extra_origins = std::move(extra_origins);
 }
 
 void HttpServer::close() {

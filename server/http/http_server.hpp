@@ -1,17 +1,22 @@
 // The daemon's HTTP/1.1 server on Boost.Beast, after Beast's chat-multi example: a listener
 // accepting on one io_context thread and one session per connection, reading one request,
-// answering it through the Router, then reading the next (keep-alive), so at most one write is
-// in flight per session. Limits: header and body size (431, 413), a read/idle timeout, and the
-// Host header must name the listen address (a DNS-rebinding defence) or the request gets 403.
+// answering it, then reading the next (keep-alive), so at most one write is in flight per
+// session. /api/... and /metrics go to the Router, an upgrade on /ws becomes a WsSession of the
+// hub (ws_session.hpp), any other path is a file of the dashboard (static_files.hpp). Limits:
+// header and body size (431, 413), a read/idle timeout, and the Host header must name the
+// listen address (a DNS-rebinding defence) or the request gets 403; a WebSocket upgrade must
+// also come from an allowed Origin (a cross-site WebSocket hijacking defence), else 403.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <set>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -30,6 +35,11 @@ struct ServerLimits {
 // Host header values accepted for a server listening on host:port: "host:port", and for a
 // loopback address also "localhost:port", "127.0.0.1:port" and "[::1]:port".
 std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_t port);
+// Origin header values accepted on a WebSocket upgrade: "http://" + each allowed host, and
+// `extra` (--allow-origin), all lower case.
+std::set<std::string> allowed_origins(const std::set<std::string>& hosts, const std::vector<std::string>& extra);
+
+class WsHub;
 
 class HttpServer {
  public:
@@ -41,11 +51,21 @@ class HttpServer {
   ~HttpServer();
   // Binds and listens; port 0 picks a free one (see port()).
   std::error_code listen(const std::string& host, std::uint16_t port);
+  // Before listen(): Host header values accepted besides the listen address's (--allow-host:
+  // the name a reverse proxy or a container's published port is reached by); their http://
+  // origins are then allowed on /ws too.
+  void set_extra_hosts(std::vector<std::string> hosts);
+  // Before listen(): the dashboard's built files, served for paths outside /api, /ws, /metrics
+  // (without a call, those paths are 404).
+  void set_web_dir(std::filesystem::path dir);
+  // Before listen(): /ws upgrades join `hub`; browsers' Origin must be an allowed host's or one
+  // of `extra_origins` (without a call, /ws is 404).
+  void set_websocket(std::shared_ptr<WsHub> hub, std::vector<std::string> extra_origins);
   std::uint16_t port() const { return port_; }
   // Stops accepting; open sessions end after their current request.
   void close();
 
-  struct Shared;  // state every session shares (router, limits, allowed hosts)
+  struct Shared;  // state every session shares (router, limits, allowed hosts, files, hub)
 
  private:
   class Listener;

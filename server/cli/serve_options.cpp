@@ -1,0 +1,217 @@
+// Flags, environment and config file of `synbench serve`; see serve_options.hpp.
+#include "server/cli/serve_options.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "emulator/twin_config_schema.hpp"
+#include "server/cli/args.hpp"
+
+namespace synbench::cli {
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+std::vector<std::string> split_list(const std::string& list) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i <= list.size();) {
+    const std::size_t j = std::min(list.find(',', i), list.size());
+    // Items are trimmed: "a.lab:1, b.lab:2" is two items.
+    std::size_t b = i, e = j;
+    while (b < e && (list[b] == ' ' || list[b] == '\t')) ++b;
+    while (e > b && (list[e - 1] == ' ' || list[e - 1] == '\t')) --e;
+    if (e > b) out.push_back(list.substr(b, e - b));
+    i = j + 1;
+  }
+  return out;
+}
+
+// The daemon config file: every key optional, unknown keys rejected, paths relative to the file.
+struct FileSettings {
+  std::optional<std::string> listen;
+  std::optional<std::filesystem::path> data_dir, web_dir, bench;
+  std::optional<nlohmann::json> twin;  // an object, or a file name resolved to its contents
+  std::optional<std::filesystem::path> twin_file;
+  std::vector<std::string> allow_hosts, allow_origins;
+};
+
+FileSettings read_config_file(const std::filesystem::path& file, const std::string& flag) {
+  std::ifstream in(file);
+  if (!in) throw UsageError(flag, "cannot read '" + file.string() + "'");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    std::string what = e.what();
+    if (auto b = what.find("] "); b != std::string::npos) what = what.substr(b + 2);
+    throw UsageError(flag, file.string() + " is not JSON: " + what);
+  }
+  if (!doc.is_object()) throw UsageError(flag, file.string() + ": the top level must be an object");
+  const auto base = file.parent_path();
+  const auto at = [&](const std::string& key, const std::string& reason) {
+    return UsageError(flag, file.string() + ": /" + key + ": " + reason);
+  };
+  const auto text = [&](const std::string& key) {
+    const auto& v = doc[key];
+    if (!v.is_string() || v.get<std::string>().empty()) throw at(key, "must be a non-empty string");
+    return v.get<std::string>();
+  };
+  const auto path = [&](const std::string& key) {
+    std::filesystem::path p = text(key);
+    return p.is_absolute() ? p : base / p;
+  };
+  const auto strings = [&](const std::string& key) {
+    const auto& v = doc[key];
+    if (!v.is_array()) throw at(key, "must be a list of strings");
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_string()) throw at(key + "/" + std::to_string(i), "must be a string");
+      out.push_back(v[i].get<std::string>());
+    }
+    return out;
+  };
+  static const std::set<std::string> known{"listen", "data_dir", "web_dir", "bench", "twin", "allow_hosts", "allow_origins"};
+  FileSettings s;
+  for (const auto& [key, value] : doc.items()) {
+    if (!key.empty() && key.front() == '_') continue;  // comments, as in config/twin.json
+    if (!known.count(key)) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw at(key, "unknown key (expected: " + list + ")");
+    }
+  }
+  if (doc.contains("listen")) s.listen = text("listen");
+  if (doc.contains("data_dir")) s.data_dir = path("data_dir");
+  if (doc.contains("web_dir")) s.web_dir = path("web_dir");
+  if (doc.contains("bench")) s.bench = path("bench");
+  if (doc.contains("twin")) {
+    if (doc["twin"].is_object()) s.twin = doc["twin"];
+    else if (doc["twin"].is_string()) s.twin_file = path("twin");
+    else throw at("twin", "must be a twin config object or a file name (docs/emulator-config.md)");
+  }
+  if (doc.contains("allow_hosts")) {
+    for (auto& h : strings("allow_hosts")) s.allow_hosts.push_back(parse_host_value(h, flag + " " + file.string() + ": /allow_hosts"));
+  }
+  if (doc.contains("allow_origins")) {
+    for (auto& o : strings("allow_origins")) s.allow_origins.push_back(parse_origin(o, flag + " " + file.string() + ": /allow_origins"));
+  }
+  return s;
+}
+
+}  // namespace
+
+EnvLookup process_env() {
+  return [](const std::string& name) -> std::optional<std::string> {
+    const char* v = std::getenv(name.c_str());
+    if (!v || !*v) return std::nullopt;
+    return std::string(v);
+  };
+}
+
+void parse_listen(const std::string& text, const std::string& what, std::string& host, std::uint16_t& port) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
+    throw UsageError(what, "'" + text + "' is not HOST:PORT");
+  host = text.substr(0, colon);
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  const std::string p = text.substr(colon + 1);
+  char* end = nullptr;
+  const long v = std::strtol(p.c_str(), &end, 10);
+  if (end != p.c_str() + p.size() || v < 0 || v > 65535) throw UsageError(what, "'" + p + "' is not a port (0..65535)");
+  port = static_cast<std::uint16_t>(v);
+}
+
+std::string parse_origin(std::string text, const std::string& what) {
+  text = lower(text);
+  const auto sep = text.find("://");
+  const bool ok = sep != std::string::npos && (text.substr(0, sep) == "http" || text.substr(0, sep) == "https") &&
+                  sep + 3 < text.size() && text.find_first_of("/?# ", sep + 3) == std::string::npos;
+  if (!ok) throw UsageError(what, "'" + text + "' is not an origin (scheme://host[:port], no path)");
+  return text;
+}
+
+std::string parse_host_value(std::string text, const std::string& what) {
+  text = lower(text);
+  const bool ok = !text.empty() && text.find_first_of("/?# @") == std::string::npos && text.find("://") == std::string::npos;
+  if (!ok) throw UsageError(what, "'" + text + "' is not a Host header value (name:port, e.g. bench-pc.lab:8080)");
+  return text;
+}
+
+ServeOptions parse_serve_options(const std::vector<std::string>& argv, const EnvLookup& env,
+                                 const std::filesystem::path& default_web_dir) {
+  Args a(argv, {"--help"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir"},
+         {"--allow-host", "--allow-origin"});
+  if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
+  ServeOptions o;
+  o.web_dir = default_web_dir;
+
+  // Lowest first: the file, then the environment, then the flags.
+  FileSettings file;
+  if (auto f = a.text("--config")) file = read_config_file(*f, "--config");
+  else if (auto e = env("SYNBENCH_CONFIG")) file = read_config_file(*e, "SYNBENCH_CONFIG");
+
+  // One setting from its three sources: returns the value and the name of its source.
+  const auto pick = [&](const std::string& flag, const std::string& var, const std::optional<std::string>& from_file)
+      -> std::optional<std::pair<std::string, std::string>> {
+    if (auto v = a.text(flag)) return std::make_pair(*v, flag);
+    if (auto v = env(var)) return std::make_pair(*v, var);
+    if (from_file) return std::make_pair(*from_file, std::string("--config"));
+    return std::nullopt;
+  };
+  const auto opt_path = [](const std::optional<std::filesystem::path>& p) {
+    return p ? std::optional<std::string>(p->string()) : std::nullopt;
+  };
+
+  if (auto v = pick("--listen", "SYNBENCH_LISTEN", file.listen)) parse_listen(v->first, v->second, o.listen_host, o.listen_port);
+  if (auto v = pick("--data-dir", "SYNBENCH_DATA_DIR", opt_path(file.data_dir))) {
+    if (v->first.empty()) throw UsageError(v->second, "needs a directory");
+    o.data_dir = v->first;
+  }
+  if (auto v = pick("--web-dir", "SYNBENCH_WEB_DIR", opt_path(file.web_dir))) o.web_dir = v->first;
+  if (auto v = pick("--bench", "SYNBENCH_BENCH", opt_path(file.bench))) o.bench = v->first;
+
+  // The twin: a file from a flag or the environment replaces the config file's twin section.
+  const auto twin_from = [&](const std::string& what, const std::string& path) {
+    try {
+      o.twin = emulator::load_twin_config_file(path);
+    } catch (const std::exception& e) {
+      throw UsageError(what, e.what());
+    }
+  };
+  if (auto f = a.text("--twin-config")) twin_from("--twin-config", *f);
+  else if (auto var = env("SYNBENCH_TWIN_CONFIG")) twin_from("SYNBENCH_TWIN_CONFIG", *var);
+  else if (file.twin_file) twin_from("--config: /twin", file.twin_file->string());
+  else if (file.twin) {
+    try {
+      emulator::apply_json(o.twin, *file.twin);
+      emulator::validate(o.twin);
+    } catch (const std::exception& e) {
+      throw UsageError("--config", std::string("/twin: ") + e.what());
+    }
+  }
+
+  // Lists: flags replace the environment, which replaces the file.
+  const auto list = [&](const std::string& flag, const std::string& var, const std::vector<std::string>& from_file,
+                        std::string (*parse)(std::string, const std::string&)) {
+    std::vector<std::string> out;
+    if (!a.all(flag).empty()) {
+      for (const auto& v : a.all(flag)) out.push_back(parse(v, flag));
+    } else if (auto e = env(var)) {
+      for (const auto& v : split_list(*e)) out.push_back(parse(v, var));
+    } else {
+      out = from_file;
+    }
+    return out;
+  };
+  o.allow_hosts = list("--allow-host", "SYNBENCH_ALLOW_HOSTS", file.allow_hosts, parse_host_value);
+  o.allow_origins = list("--allow-origin", "SYNBENCH_ALLOW_ORIGINS", file.allow_origins, parse_origin);
+  return o;
+}
+
+}  // namespace synbench::cli

@@ -1,0 +1,87 @@
+// One /ws connection after the HTTP upgrade (the HTTP session has already checked Host and
+// Origin). Protocol (docs/api.md): the first message must be {"op":"auth","token":...} within
+// 10 s, else an `unauthorized` error and close 1008; then subscribe/unsubscribe to telemetry
+// (at the client's rate), sweep and events, and `request`s dispatched through the REST Router
+// with the session's token, so roles, the control lock and validation are REST's own.
+// Writes: one in flight, behind a bounded queue; a client whose queue overflows or whose write
+// stalls is dropped (its socket closed) so it costs the daemon neither memory nor other
+// clients' rate.
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include "server/http/ws_hub.hpp"
+
+namespace synbench::http {
+
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  // `slot` is held for the session's life (the server's connection count).
+  WsSession(boost::asio::ip::tcp::socket&& socket, std::shared_ptr<WsHub> hub, std::shared_ptr<void> slot);
+  ~WsSession();
+  // Answers the upgrade request with 101 and starts the session.
+  void run(boost::beast::http::request<boost::beast::http::string_body> req);
+  // From the hub, on any thread: the session takes what its subscriptions want on its strand.
+  void deliver(std::shared_ptr<const HubTick> tick);
+
+ private:
+  void on_accept(boost::beast::error_code ec);
+  void do_read();
+  void on_read(boost::beast::error_code ec, std::size_t bytes);
+  void on_auth_timeout(boost::beast::error_code ec);
+  void on_tick(const HubTick& tick);
+  void handle(const std::string& text);
+  void handle_auth(const nlohmann::json& doc);
+  void handle_subscribe(const nlohmann::json& doc, bool subscribe);
+  void handle_request(const nlohmann::json& doc);
+  void bad_message(const std::string& message);
+  // An `unauthorized` error, then close 1008 once it is written.
+  void refuse(const std::string& message);
+  void send(SharedText message);
+  void send(const nlohmann::json& message);
+  void do_write();
+  void on_write(boost::beast::error_code ec, std::size_t bytes);
+  // The planned close (after refuse()) once the queue is written.
+  void close_if_due();
+  // Closes the socket at once: for a client that does not read.
+  void drop(const std::string& reason);
+
+  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  std::shared_ptr<WsHub> hub_;
+  std::shared_ptr<void> slot_;
+  boost::beast::flat_buffer buffer_;
+  boost::asio::steady_timer auth_timer_;
+  bool joined_ = false;
+
+  // Authentication: the token is kept to authorise each request as REST does (so a revoked
+  // token stops working) and never logged.
+  std::optional<Identity> identity_;
+  std::string token_;
+
+  // Subscriptions.
+  bool telemetry_ = false, sweep_ = false, events_ = false;
+  double period_ticks_ = 5;           // hub ticks per telemetry message (50 Hz / rate)
+  std::optional<double> next_tick_;   // hub tick index of the next telemetry message
+
+  // The write queue: at most one async_write in flight.
+  std::deque<SharedText> queue_;
+  std::size_t queued_bytes_ = 0;
+  bool writing_ = false;
+  std::chrono::steady_clock::time_point write_started_{};
+  bool closing_ = false;  // a close is planned or under way: nothing more is queued
+  bool close_after_write_ = false;
+  bool dropped_ = false;
+};
+
+}  // namespace synbench::http

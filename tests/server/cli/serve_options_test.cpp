@@ -1,0 +1,125 @@
+// serve_options: precedence flag > environment > config file > default, and every error naming
+// its source (the flag, the variable, the file and JSON pointer).
+#include "server/cli/serve_options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "server/cli/args.hpp"
+
+namespace synbench::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Env {
+  std::map<std::string, std::string> vars;
+  EnvLookup lookup() const {
+    return [this](const std::string& n) -> std::optional<std::string> {
+      auto it = vars.find(n);
+      if (it == vars.end()) return std::nullopt;
+      return it->second;
+    };
+  }
+};
+
+fs::path write_file(const std::string& name, const std::string& text) {
+  const auto dir = fs::temp_directory_path() / "synbench-serve-options-test";
+  fs::create_directories(dir);
+  const auto p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+// The message of the UsageError parse throws, or "" when it does not.
+std::string error_of(const std::vector<std::string>& argv, const Env& env = {}) {
+  try {
+    parse_serve_options(argv, env.lookup(), "/web");
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ServeOptions, DefaultsAreLoopbackAndTheCompiledWebDir) {
+  const auto o = parse_serve_options({}, Env{}.lookup(), "/src/web/dist");
+  EXPECT_EQ(o.listen_host, "127.0.0.1");
+  EXPECT_EQ(o.listen_port, 8080);
+  EXPECT_EQ(o.data_dir, "synbench-data");
+  EXPECT_EQ(o.web_dir, "/src/web/dist");
+  EXPECT_FALSE(o.bench);
+  EXPECT_TRUE(o.allow_hosts.empty());
+  EXPECT_DOUBLE_EQ(o.twin.firmware.max_speed_rpm, emulator::TwinConfig{}.firmware.max_speed_rpm);
+}
+
+TEST(ServeOptions, FlagBeatsEnvironmentBeatsFile) {
+  const auto cfg = write_file("precedence.json", R"({"listen": "127.0.0.1:7001", "data_dir": "data-from-file",
+    "allow_hosts": ["bench.lab:7001"], "_comment": "ignored"})");
+  Env env;
+  env.vars["SYNBENCH_CONFIG"] = cfg.string();
+  auto o = parse_serve_options({}, env.lookup(), "/web");
+  EXPECT_EQ(o.listen_port, 7001);
+  EXPECT_EQ(o.data_dir, cfg.parent_path() / "data-from-file");  // relative to the file
+  EXPECT_EQ(o.allow_hosts, std::vector<std::string>{"bench.lab:7001"});
+  env.vars["SYNBENCH_LISTEN"] = "127.0.0.1:7002";
+  env.vars["SYNBENCH_ALLOW_HOSTS"] = "A.lab:1, b.lab:2,";
+  o = parse_serve_options({}, env.lookup(), "/web");
+  EXPECT_EQ(o.listen_port, 7002);
+  EXPECT_EQ(o.allow_hosts, (std::vector<std::string>{"a.lab:1", "b.lab:2"}));
+  o = parse_serve_options({"--listen", "127.0.0.1:7003", "--allow-host", "c.lab:3"}, env.lookup(), "/web");
+  EXPECT_EQ(o.listen_port, 7003);
+  EXPECT_EQ(o.allow_hosts, std::vector<std::string>{"c.lab:3"});
+  EXPECT_EQ(o.data_dir, cfg.parent_path() / "data-from-file");  // untouched by the others
+}
+
+TEST(ServeOptions, TwinSectionOverlaysTheDefaults) {
+  const auto cfg = write_file("twin.json", R"({"twin": {"firmware": {"max_speed_rpm": 1200}}})");
+  const auto o = parse_serve_options({"--config", cfg.string()}, Env{}.lookup(), "/web");
+  EXPECT_DOUBLE_EQ(o.twin.firmware.max_speed_rpm, 1200);
+  EXPECT_DOUBLE_EQ(o.twin.firmware.overspeed_trip_rpm, emulator::TwinConfig{}.firmware.overspeed_trip_rpm);
+}
+
+TEST(ServeOptions, ErrorsNameTheirSource) {
+  EXPECT_NE(error_of({"--listen", "nonsense"}).find("--listen"), std::string::npos);
+  Env env;
+  env.vars["SYNBENCH_LISTEN"] = "127.0.0.1:99999";
+  EXPECT_NE(error_of({}, env).find("SYNBENCH_LISTEN"), std::string::npos);
+  EXPECT_NE(error_of({}, env).find("99999"), std::string::npos);
+  env.vars.clear();
+  env.vars["SYNBENCH_ALLOW_ORIGINS"] = "http://ok.lab,ftp://bad";
+  EXPECT_NE(error_of({}, env).find("SYNBENCH_ALLOW_ORIGINS"), std::string::npos);
+  EXPECT_NE(error_of({"--allow-origin", "http://x.lab/path"}).find("--allow-origin"), std::string::npos);
+  EXPECT_NE(error_of({"--allow-host", "http://x.lab"}).find("--allow-host"), std::string::npos);
+  EXPECT_NE(error_of({"--config", "/nonexistent/synbench.json"}).find("cannot read"), std::string::npos);
+
+  const auto unknown = write_file("unknown.json", R"({"listen": "127.0.0.1:1", "lissten": 2})");
+  const auto e1 = error_of({"--config", unknown.string()});
+  EXPECT_NE(e1.find("/lissten"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("unknown key"), std::string::npos) << e1;
+  const auto typed = write_file("typed.json", R"({"allow_hosts": ["ok.lab:1", 5]})");
+  EXPECT_NE(error_of({"--config", typed.string()}).find("/allow_hosts/1"), std::string::npos);
+  const auto bad_json = write_file("bad.json", R"({"listen": )");
+  EXPECT_NE(error_of({"--config", bad_json.string()}).find("not JSON"), std::string::npos);
+  const auto bad_twin = write_file("bad_twin.json", R"({"twin": {"firmware": {"max_speed_rpm": -5}}})");
+  const auto e2 = error_of({"--config", bad_twin.string()});
+  EXPECT_NE(e2.find("/twin"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("max_speed_rpm"), std::string::npos) << e2;
+  EXPECT_NE(error_of({"extra"}).find("unexpected argument"), std::string::npos);
+  EXPECT_NE(error_of({"--data-dir", ""}).find("--data-dir"), std::string::npos);
+}
+
+TEST(ServeOptions, ParsersAcceptWhatTheyShould) {
+  std::string host;
+  std::uint16_t port = 0;
+  parse_listen("[::1]:8081", "--listen", host, port);
+  EXPECT_EQ(host, "::1");
+  EXPECT_EQ(port, 8081);
+  EXPECT_EQ(parse_origin("HTTPS://Bench.Lab:8443", "x"), "https://bench.lab:8443");
+  EXPECT_EQ(parse_host_value("Bench.Lab:8080", "x"), "bench.lab:8080");
+}
+
+}  // namespace
+}  // namespace synbench::cli

@@ -1,0 +1,294 @@
+// synbench dashboard: sign-in, the live link, routing between the four views, the always-visible
+// E-stop and the keyboard shortcuts. State shared by the views lives in `app`.
+import './style.css';
+import { api, setToken, setUnauthorizedHandler, ApiError } from './api.js';
+import { Link } from './link.js';
+import { LiveView } from './views/live.js';
+import { SweepView } from './views/sweep.js';
+import { ResultsView } from './views/results.js';
+import { HistoryView } from './views/history.js';
+
+const $ = (s) => document.querySelector(s);
+const TOKEN_KEY = 'synbench.token';
+
+class App {
+  constructor() {
+    this.role = null;
+    this.callerId = null;
+    this.status = null;          // last GET /api/bench/status (or WS state push)
+    this.sweeps = [];            // run history
+    this.listeners = new Map();
+    this.link = null;
+    this.view = 'live';
+  }
+
+  on(ev, fn) { (this.listeners.get(ev) || this.listeners.set(ev, []).get(ev)).push(fn); }
+  emit(ev, arg) { for (const fn of this.listeners.get(ev) || []) { try { fn(arg); } catch (e) { console.error(e); } } }
+
+  get isOperator() { return this.role === 'operator'; }
+
+  toast(text, bad = false) {
+    const t = $('#toast');
+    t.textContent = text;
+    t.classList.toggle('bad', bad);
+    t.classList.add('show');
+    clearTimeout(this.toastTimer);
+    this.toastTimer = setTimeout(() => t.classList.remove('show'), bad ? 6000 : 2500);
+  }
+
+  // Runs an operator command (over the socket when up, else REST) and reports errors.
+  async command(method, path, body, okText) {
+    try {
+      const r = await this.link.request(method, path, body);
+      if (okText) this.toast(okText);
+      if (r && r.t_s !== undefined && r.supervisor) this.setStatus(r);
+      return r;
+    } catch (e) {
+      this.toast(`${path.replace('/api/', '')}: ${e.message}${e.code ? ` (${e.code})` : ''}`, true);
+      throw e;
+    }
+  }
+
+  setStatus(st) {
+    this.status = st;
+    this.emit('status', st);
+    renderBenchPills(st);
+  }
+
+  async refreshSweeps() {
+    try {
+      this.sweeps = await api('GET', '/api/sweeps');
+      this.emit('sweeps', this.sweeps);
+    } catch (e) { if (e.status !== 401) console.warn('sweeps', e.message); }
+  }
+
+  async refreshAll() {
+    try { this.setStatus(await api('GET', '/api/bench/status')); } catch { /* link reports offline */ }
+    await this.refreshSweeps();
+    this.emit('refresh');
+  }
+}
+
+export const app = new App();
+window.synbench = app; // for the end-to-end tests and the console
+
+// ---- indicators -------------------------------------------------------------------------------
+function renderConn(state) {
+  const el = $('#conn');
+  el.dataset.state = state;
+  el.textContent = { connected: 'connected', polling: 'connected (REST polling)', connecting: 'connecting…', offline: 'offline, reconnecting…' }[state] || state;
+  document.body.dataset.conn = state;
+  if (state === 'offline') {
+    const b = $('#bench-pill');
+    b.dataset.state = 'unknown';
+    b.textContent = 'bench ?';
+    const f = $('#fault-pill');
+    f.dataset.state = 'unknown';
+    f.textContent = 'faults ?';
+  }
+}
+
+function renderBenchPills(st) {
+  if (document.body.dataset.conn === 'offline') return;
+  const b = $('#bench-pill');
+  const f = $('#fault-pill');
+  const phase = st.supervisor?.phase;
+  let state = 'disabled', text = 'bench disabled';
+  if (phase === 'estopped') { state = 'estopped'; text = 'E-STOPPED'; }
+  else if (st.stopping || phase === 'stopping_load' || phase === 'stopping_speed') { state = 'stopping'; text = 'stopping'; }
+  else if (st.sweep && ['running', 'pausing', 'paused', 'stopping'].includes(st.sweep.state)) { state = 'running'; text = `sweep ${st.sweep.state}`; }
+  else if (st.enabled) { state = 'running'; text = 'bench enabled'; }
+  else if (!st.synrm) { state = 'bad'; text = 'link down'; }
+  b.dataset.state = state;
+  b.textContent = text;
+  document.body.dataset.bench = state;
+  const trip = st.supervisor?.trip;
+  const driveFault = [st.synrm?.fault, st.load?.fault].find((x) => x && x !== 'none');
+  if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${trip.fault}`; f.title = trip.detail || ''; }
+  else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
+  else if (st.synrm?.voltage_limited) { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
+  else { f.dataset.state = 'ok'; f.textContent = 'no fault'; }
+}
+
+function renderRole() {
+  const r = $('#role-pill');
+  r.dataset.state = app.role || 'none';
+  r.textContent = app.role === 'operator' ? 'operator' : app.role === 'viewer' ? 'viewer · read-only' : 'signed out';
+  r.title = app.role ? `${app.role}${app.callerId ? ` (${app.callerId})` : ''}` : 'Not signed in';
+  document.body.classList.toggle('role-viewer', app.role === 'viewer');
+  document.body.classList.toggle('role-operator', app.role === 'operator');
+  for (const el of document.querySelectorAll('.operator-only button, .operator-only input, .operator-only select, #estop'))
+    el.disabled = app.role !== 'operator';
+  $('#estop').title = app.role === 'operator' ? 'Emergency stop: both drives disabled at once, latched until reset (key: Esc)'
+    : 'E-stop needs an operator token (you are signed in as a viewer)';
+  app.emit('role', app.role);
+}
+
+// ---- sign-in ----------------------------------------------------------------------------------
+async function whoami() {
+  try {
+    return await api('GET', '/api/whoami', undefined, { quiet401: true });
+  } catch (e) {
+    if (e.status !== 404 && e.status !== 405) throw e;
+  }
+  // Older daemon without /api/whoami: validate with a viewer route, then tell operator from
+  // viewer by releasing the control lock (viewer: 403; operator: 200, or 409 when another holds it).
+  await api('GET', '/api/bench/status', undefined, { quiet401: true });
+  try {
+    await api('DELETE', '/api/bench/lock', undefined, { quiet401: true });
+    return { role: 'operator', id: null };
+  } catch (e) {
+    if (e.status === 403) return { role: 'viewer', id: null };
+    if (e.status === 409) return { role: 'operator', id: null };
+    throw e;
+  }
+}
+
+function storedToken() { return sessionStorage.getItem(TOKEN_KEY) || localStorage.getItem(TOKEN_KEY); }
+
+async function signIn(token, remember) {
+  setToken(token);
+  const me = await whoami();
+  app.role = me.role;
+  app.callerId = me.id;
+  sessionStorage.setItem(TOKEN_KEY, token);
+  if (remember) localStorage.setItem(TOKEN_KEY, token); else if (remember === false) localStorage.removeItem(TOKEN_KEY);
+  renderRole();
+  startLink();
+  await app.refreshAll();
+}
+
+function showSignIn(message = '') {
+  const d = $('#signin');
+  $('#signin-error').textContent = message;
+  if (!d.open) d.showModal();
+  $('#signin-token').focus();
+}
+
+function signOut() {
+  sessionStorage.removeItem(TOKEN_KEY);
+  localStorage.removeItem(TOKEN_KEY);
+  setToken(null);
+  app.role = null;
+  if (app.link) app.link.stop();
+  app.link = null;
+  renderRole();
+  showSignIn();
+}
+
+function startLink() {
+  if (app.link) app.link.stop();
+  app.link = new Link({
+    state: (s) => { renderConn(s); app.emit('conn', s); },
+    telemetry: (t) => app.emit('telemetry', t),
+    status: (st) => app.setStatus(st),
+    sweep: (s) => {
+      if (app.status && s.id != null) { app.status.sweep = { ...(app.status.sweep || {}), ...s }; renderBenchPills(app.status); }
+      app.emit('sweep-progress', s);
+    },
+    event: (e) => app.emit('event', e),
+    hello: (h) => { if (h.role && h.role !== app.role) { app.role = h.role; renderRole(); } if (h.id) app.callerId = h.id; },
+    unauthorized: () => showSignIn('The daemon no longer accepts this token.'),
+    restored: () => { whoami().then((me) => { app.role = me.role; app.callerId = me.id; renderRole(); }).catch(() => {}); app.refreshAll(); app.toast('Reconnected to the daemon'); },
+  });
+  app.link.start();
+}
+
+// The socket pushes a state message only when enabled/phase/trip change: setpoints, the sweep
+// and events are refreshed from GET /api/bench/status once a second (the REST fallback polls
+// faster by itself).
+setInterval(() => {
+  if (app.link && app.link.state === 'connected') api('GET', '/api/bench/status', undefined, { quiet401: true }).then((st) => app.setStatus(st)).catch(() => {});
+}, 1000);
+
+// ---- routing and shortcuts --------------------------------------------------------------------
+const VIEWS = ['live', 'sweep', 'results', 'history'];
+function route() {
+  const m = /^#\/(\w+)(?:\/(\d+))?/.exec(location.hash);
+  const view = m && VIEWS.includes(m[1]) ? m[1] : 'live';
+  app.view = view;
+  for (const s of document.querySelectorAll('.view')) s.hidden = s.dataset.view !== view;
+  for (const a of document.querySelectorAll('[data-nav]')) {
+    if (a.dataset.nav === view) a.setAttribute('aria-current', 'page'); else a.removeAttribute('aria-current');
+  }
+  app.emit('view', { view, arg: m?.[2] ? Number(m[2]) : null });
+}
+
+async function estop() {
+  if (!app.link || !app.isOperator) { app.toast('E-stop needs an operator token', true); return; }
+  $('#estop').classList.add('pressed');
+  // REST and the socket at once: the first to arrive stops the bench, the second is a no-op.
+  const rest = api('POST', '/api/bench/estop', {}).then((st) => { app.setStatus(st); return st; });
+  const viaWs = app.link.state === 'connected' ? app.link.request('POST', '/api/bench/estop', {}) : Promise.reject(new Error('no socket'));
+  try {
+    await Promise.any([rest, viaWs]);
+    app.toast('E-STOP: both drives disabled (reset to clear)');
+  } catch (e) {
+    app.toast(`E-stop failed: ${e.errors?.[0]?.message || e.message}`, true);
+  }
+}
+
+document.addEventListener('keydown', (e) => {
+  if (e.key === 'Escape') {
+    // Esc is the E-stop everywhere, also in fields and dialogs (except the sign-in dialog).
+    if ($('#signin').open) return;
+    e.preventDefault();
+    estop();
+    return;
+  }
+  const t = e.target;
+  const typing = t && (t.isContentEditable || ['INPUT', 'SELECT', 'TEXTAREA'].includes(t.tagName));
+  if (typing || e.ctrlKey || e.metaKey || e.altKey || document.querySelector('dialog[open]')) return;
+  if (/^[1-4]$/.test(e.key)) { location.hash = `#/${VIEWS[Number(e.key) - 1]}`; e.preventDefault(); }
+  else if (e.key === '?') { $('#help').showModal(); e.preventDefault(); }
+});
+
+// ---- start ------------------------------------------------------------------------------------
+function init() {
+  renderConn('offline');
+  renderRole();
+  $('#estop').addEventListener('click', estop);
+  $('#signout').addEventListener('click', signOut);
+  $('#help').addEventListener('cancel', (e) => e.preventDefault());
+  $('#signin').addEventListener('cancel', (e) => e.preventDefault());
+  $('#signin-form').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    const token = $('#signin-token').value.trim();
+    $('#signin-submit').disabled = true;
+    try {
+      await signIn(token, $('#signin-remember').checked);
+      $('#signin').close();
+      $('#signin-token').value = '';
+      app.toast(`Signed in as ${app.role}`);
+    } catch (err) {
+      $('#signin-error').textContent = err instanceof ApiError && err.status === 401 ? 'Unknown token.' : `Cannot sign in: ${err.message}`;
+    } finally {
+      $('#signin-submit').disabled = false;
+    }
+  });
+  setUnauthorizedHandler(() => showSignIn('The daemon refused the token; sign in again.'));
+
+  new LiveView(app);
+  new SweepView(app);
+  new ResultsView(app);
+  new HistoryView(app);
+  window.addEventListener('hashchange', route);
+  route();
+
+  const saved = storedToken();
+  if (saved) {
+    signIn(saved).catch((e) => {
+      if (e.status === 401) showSignIn('The saved token is no longer valid.');
+      else { setToken(saved); app.role = null; renderRole(); startLink(); retrySignIn(saved); }
+    });
+  } else {
+    showSignIn();
+  }
+}
+
+// Daemon down at page load: keep trying to identify the saved token.
+function retrySignIn(token) {
+  setTimeout(() => signIn(token).catch((e) => { if (e.status === 401) showSignIn('The saved token is no longer valid.'); else retrySignIn(token); }), 2000);
+}
+
+init();

@@ -1,0 +1,165 @@
+// ECharts options of the result plots, shared by the progress panel and the results view. Input
+// is the analysis JSON (docs/analysis.md) or the points JSON (docs/record.md).
+import { axis, PALETTE } from '../charts.js';
+
+const r2 = (v, d = 2) => (v == null || !Number.isFinite(v) ? null : Number(v.toFixed(d)));
+const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
+export const cfgLabel = (c) => `${c.estimator} / ${c.pwm}`;
+
+// Efficiency map (P_m / P_dcM at the ME angle) over load x speed, as a heat map with values.
+export function effMapOption(analysis, cfg) {
+  const e = (analysis?.efficiency_map?.entries || []).find((x) => sameCfg(x, cfg)) || analysis?.efficiency_map?.entries?.[0];
+  if (!e) return { series: [] };
+  const data = [];
+  e.speeds_rpm.forEach((s, i) => e.loads_Nm.forEach((l, j) => {
+    const v = e.efficiency[i]?.[j];
+    if (v != null) data.push([j, i, r2(v * 100, 1)]);
+  }));
+  const vals = data.map((d) => d[2]);
+  return {
+    tooltip: { trigger: 'item', formatter: (p) => `${e.speeds_rpm[p.value[1]]} rpm, ${e.loads_Nm[p.value[0]]} N m<br>η = ${p.value[2]} %` },
+    grid: { left: 64, right: 80, top: 24, bottom: 40 },
+    xAxis: { type: 'category', name: 'load torque T_L [N m]', nameLocation: 'middle', nameGap: 26, data: e.loads_Nm.map(String),
+      axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
+    yAxis: { type: 'category', name: 'speed [rpm]', nameLocation: 'middle', nameGap: 44, data: e.speeds_rpm.map(String),
+      axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
+    visualMap: { min: vals.length ? Math.floor(Math.min(...vals) / 5) * 5 : 0, max: vals.length ? Math.ceil(Math.max(...vals) / 5) * 5 : 100,
+      calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160, text: ['η %', ''], textStyle: { color: '#14181f' },
+      inRange: { color: ['#313695', '#4575b4', '#74add1', '#abd9e9', '#fee090', '#fdae61', '#f46d43', '#a50026'] } },
+    series: [{ name: `efficiency ${cfgLabel(e)}`, type: 'heatmap', data,
+      label: { show: data.length <= 80, color: '#000', textBorderColor: '#fff', textBorderWidth: 2, fontWeight: 600, formatter: (p) => p.value[2].toFixed(1) },
+      emphasis: { itemStyle: { borderColor: '#000', borderWidth: 1 } } }],
+  };
+}
+
+// MTPA (solid) and ME (dashed) angle against load, one colour per speed.
+export function trajectoriesOption(analysis, cfg) {
+  let curves = (analysis?.curves?.entries || []).filter((c) => sameCfg(c, cfg));
+  if (!curves.length && analysis?.curves?.entries?.length) {
+    const first = analysis.curves.entries[0];
+    curves = analysis.curves.entries.filter((c) => sameCfg(c, first));
+  }
+  const speeds = [...new Set(curves.map((c) => c.speed_rpm))].sort((a, b) => a - b);
+  const series = [];
+  speeds.forEach((s, k) => {
+    const cs = curves.filter((c) => c.speed_rpm === s).sort((a, b) => a.load_Nm - b.load_Nm);
+    const color = PALETTE[k % PALETTE.length];
+    series.push({ name: `MTPA ${s} rpm`, type: 'line', color, symbol: 'circle', symbolSize: 7, data: cs.map((c) => [c.load_Nm, r2(c.mtpa?.angle_deg)]) });
+    series.push({ name: `ME ${s} rpm`, type: 'line', color, symbol: 'diamond', symbolSize: 8, lineStyle: { type: 'dashed' }, data: cs.map((c) => [c.load_Nm, r2(c.me?.angle_deg)]) });
+  });
+  return {
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    grid: { left: 56, right: 16, top: 40, bottom: 40 },
+    tooltip: { trigger: 'axis', valueFormatter: (v) => (v == null ? '–' : `${v}°`) },
+    xAxis: axis('load torque T_L [N m]', { nameGap: 26 }),
+    yAxis: axis('current angle θ_i [deg]', { nameGap: 36 }),
+    series,
+  };
+}
+
+// I_m (left axis) and P_dcM (right axis) against the current angle at one (speed, load), one
+// colour per configuration; MTPA and ME optima marked.
+export function curveOption(points, analysis, speed, load, configs) {
+  const at = points.filter((p) => p.speed_rpm === speed && p.load_Nm === load);
+  const series = [];
+  configs.forEach((cfg, k) => {
+    const rs = at.filter((p) => sameCfg(p, cfg)).sort((a, b) => a.angle_deg - b.angle_deg);
+    if (!rs.length) return;
+    const color = PALETTE[k % PALETTE.length];
+    const c = (analysis?.curves?.entries || []).find((x) => sameCfg(x, cfg) && x.speed_rpm === speed && x.load_Nm === load);
+    const mark = (o, axisName) => (o ? { symbol: 'pin', symbolSize: 36, label: { fontSize: 10, color: '#fff' },
+      data: [{ name: axisName, coord: [r2(o.angle_deg), r2(axisName === 'MTPA' ? o.im_A : o.pdcm_W, 3)], value: axisName }] } : undefined);
+    series.push({ name: `I_m ${cfgLabel(cfg)}`, type: 'line', color, yAxisIndex: 0, symbol: 'circle', symbolSize: 6,
+      data: rs.map((p) => [p.angle_deg, r2(p.im_A, 4)]), markPoint: mark(c?.mtpa, 'MTPA') });
+    series.push({ name: `P_dcM ${cfgLabel(cfg)}`, type: 'line', color, yAxisIndex: 1, symbol: 'rect', symbolSize: 6, lineStyle: { type: 'dashed' },
+      data: rs.map((p) => [p.angle_deg, r2(p.pdcm_W, 2)]), markPoint: mark(c?.me, 'ME') });
+  });
+  return {
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    grid: { left: 56, right: 60, top: 40, bottom: 40 },
+    xAxis: axis('current angle θ_i [deg]', { nameGap: 26 }),
+    yAxis: [axis('I_m [A] (solid)', { nameGap: 40 }), axis('P_dcM [W] (dashed)', { nameGap: 44, splitLine: { show: false } })],
+    series,
+  };
+}
+
+// Position error min / mean / max (of the window means) against load, one colour per speed
+// (thesis Figs. 6.13-6.15); faint window extremes.
+export function posErrOption(analysis, cfg) {
+  const es = (analysis?.position_error?.entries || []).filter((e) => sameCfg(e, cfg)).sort((a, b) => a.speed_rpm - b.speed_rpm);
+  const series = [];
+  es.forEach((e, k) => {
+    const color = PALETTE[k % PALETTE.length];
+    const d = (f) => e.loads.map((l) => [l.load_Nm, r2(l[f], 3)]);
+    series.push({ name: `mean ${e.speed_rpm} rpm`, type: 'line', color, symbol: 'circle', symbolSize: 7, data: d('mean_deg') });
+    series.push({ name: `min ${e.speed_rpm} rpm`, type: 'scatter', color, symbol: 'triangle', symbolRotate: 180, symbolSize: 9, data: d('min_deg') });
+    series.push({ name: `max ${e.speed_rpm} rpm`, type: 'scatter', color, symbol: 'triangle', symbolSize: 9, data: d('max_deg') });
+  });
+  return {
+    // one legend entry per speed (its mean); the markers are explained in the title
+    legend: { top: 0, left: 0, type: 'scroll', data: es.map((e) => `mean ${e.speed_rpm} rpm`), textStyle: { color: '#14181f' } },
+    title: { text: '▼ min   ● mean   ▲ max', right: 8, top: 2, textStyle: { fontSize: 12, fontWeight: 'normal', color: '#333b47' } },
+    grid: { left: 56, right: 16, top: 40, bottom: 40 },
+    tooltip: { trigger: 'axis' },
+    xAxis: axis('load torque T_L [N m]', { nameGap: 26 }),
+    yAxis: axis('position error [deg]', { nameGap: 40 }),
+    series,
+  };
+}
+
+// Delta I_m (MTPA trajectory) and Delta P_dcM (ME trajectory) against the reference per (speed,
+// load), one bar series per configuration (Fig. 6.21).
+export function deltaOption(analysis) {
+  const es = analysis?.deltas?.entries || [];
+  const keys = [...new Set(es.map((e) => `${e.speed_rpm}|${e.load_Nm}`))]
+    .sort((a, b) => { const [sa, la] = a.split('|').map(Number); const [sb, lb] = b.split('|').map(Number); return sa - sb || la - lb; });
+  const cfgs = [];
+  for (const e of es) if (!cfgs.some((c) => sameCfg(c, e))) cfgs.push({ estimator: e.estimator, pwm: e.pwm });
+  const cats = keys.map((k) => { const [s, l] = k.split('|'); return `${s} rpm\n${l} N m`; });
+  const series = [];
+  cfgs.forEach((cfg, k) => {
+    const color = PALETTE[(k + 1) % PALETTE.length];
+    const val = (f, o) => keys.map((key) => { const e = es.find((x) => sameCfg(x, cfg) && `${x.speed_rpm}|${x.load_Nm}` === key); return e ? r2(e[o]?.[f], 4) : null; });
+    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 0, yAxisIndex: 0, data: val('delta_im_A', 'mtpa') });
+    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 1, yAxisIndex: 1, data: val('delta_pdcm_W', 'me') });
+  });
+  const ref = analysis?.deltas?.reference;
+  return {
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    title: ref ? { text: `vs ${cfgLabel(ref)}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } } : undefined,
+    tooltip: { trigger: 'axis' },
+    grid: [{ left: 60, right: 16, top: 40, height: '30%' }, { left: 60, right: 16, bottom: 44, height: '30%' }],
+    xAxis: [{ type: 'category', data: cats, gridIndex: 0, axisLabel: { show: false } },
+      { type: 'category', data: cats, gridIndex: 1, axisLabel: { color: '#333b47', fontSize: 10 } }],
+    // bars start at zero
+    yAxis: [axis('ΔI_m [A]', { gridIndex: 0, nameGap: 48, scale: false }), axis('ΔP_dcM [W]', { gridIndex: 1, nameGap: 48, scale: false })],
+    series,
+  };
+}
+
+// Histograms of one configuration (Figs. 6.16-6.19): up to four panels.
+const HQ = [['pos_err_mean_deg', 'position error [deg]'], ['ld_err_pct', 'L_d error [%]'], ['lq_err_pct', 'L_q error [%]'], ['rs_err_pct', 'R_s error [%]']];
+export function histOption(analysis, cfg) {
+  const es = (analysis?.histograms?.entries || []).filter((e) => sameCfg(e, cfg));
+  const present = HQ.filter(([q]) => es.some((e) => e.quantity === q));
+  const n = present.length;
+  const grid = [];
+  const xAxis = [];
+  const yAxis = [];
+  const series = [];
+  const title = [];
+  present.forEach(([q, label], k) => {
+    const e = es.find((x) => x.quantity === q);
+    const col = k % 2;
+    const row = Math.floor(k / 2);
+    const rows = Math.ceil(n / 2);
+    const w = n === 1 ? 88 : 40;
+    grid.push({ left: `${7 + col * 50}%`, width: `${w}%`, top: `${8 + row * (90 / rows)}%`, height: `${90 / rows - 22}%` });
+    xAxis.push({ type: 'category', gridIndex: k, data: e.bins.map((b) => r2(b.from, 2)), name: label, nameLocation: 'middle', nameGap: 22,
+      axisLabel: { color: '#333b47', fontSize: 10 }, nameTextStyle: { color: '#333b47', fontWeight: 600 } });
+    yAxis.push(axis('', { gridIndex: k, minInterval: 1, scale: false }));
+    series.push({ type: 'bar', name: label, xAxisIndex: k, yAxisIndex: k, barCategoryGap: '5%', color: PALETTE[k], data: e.bins.map((b) => b.count) });
+    title.push({ text: `n=${e.count}, mean ${r2(e.mean, 2)}`, left: `${7 + col * 50}%`, top: `${1 + row * (90 / rows)}%`, textStyle: { fontSize: 11, fontWeight: 'normal', color: '#4a5361' } });
+  });
+  return { grid, xAxis, yAxis, series, title, tooltip: { trigger: 'axis' } };
+}

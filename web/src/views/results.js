@@ -1,0 +1,158 @@
+// Results view: one sweep's analysis drawn as the thesis draws it, with exports.
+import { api, download, saveBlob } from '../api.js';
+import { ChartCard } from '../charts.js';
+import { analyzeClient, analysisConfigs } from '../analysis.js';
+import { effMapOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
+import { escapeHtml } from './live.js';
+
+const $ = (s) => document.querySelector(s);
+const key = (c) => `${c.estimator}/${c.pwm}`;
+
+export class ResultsView {
+  constructor(app) {
+    this.app = app;
+    this.cards = {
+      map: new ChartCard($('[data-chart="r-map"]'), { title: 'Efficiency map P_m / P_dcM at the ME angle' }),
+      traj: new ChartCard($('[data-chart="r-traj"]'), { title: 'MTPA and ME angle against load (Fig. 6.20)' }),
+      curve: new ChartCard($('[data-chart="r-curve"]'), { title: 'I_m and P_dcM against angle' }),
+      poserr: new ChartCard($('[data-chart="r-poserr"]'), { title: 'Position error against load (Figs. 6.13-6.15)' }),
+      delta: new ChartCard($('[data-chart="r-delta"]'), { title: 'ΔI_m (MTPA) and ΔP_dcM (ME) vs reference (Fig. 6.21)' }),
+      hist: new ChartCard($('[data-chart="r-hist"]'), { title: 'Histograms (Figs. 6.16-6.19)' }),
+    };
+    this.sweepId = null;
+    this.points = [];
+    this.analysis = null;
+    app.on('sweeps', (list) => this.fillSweeps(list));
+    app.on('view', async ({ view, arg }) => {
+      this.visible = view === 'results';
+      if (!this.visible) return;
+      await app.refreshSweeps();
+      if (arg) this.sweepId = arg;
+      if (!this.sweepId) {
+        const done = (app.sweeps || []).filter((s) => s.points_stored > 0);
+        this.sweepId = done.length ? done[done.length - 1].id : null;
+      }
+      this.fillSweeps(app.sweeps || []);
+      if (this.sweepId) this.load();
+    });
+    $('#r-sweep').addEventListener('change', () => { this.sweepId = Number($('#r-sweep').value); this.load(); });
+    $('#r-ref').addEventListener('change', () => this.load());
+    for (const id of ['#r-config', '#r-speed', '#r-load']) $(id).addEventListener('change', () => this.draw());
+    $('#r-speed').addEventListener('change', () => this.fillLoads());
+    $('#r-csv').addEventListener('click', () => this.sweepId && download(`/api/sweeps/${this.sweepId}/points?format=csv`, `sweep-${this.sweepId}-points.csv`, 'text/csv')
+      .catch((e) => app.toast(`export: ${e.message}`, true)));
+    $('#r-json').addEventListener('click', () => this.analysis && saveBlob(new Blob([JSON.stringify(this.analysis, null, 2)], { type: 'application/json' }), `sweep-${this.sweepId}-analysis.json`));
+    $('#r-acsv').addEventListener('click', () => this.exportAnalysisCsv());
+  }
+
+  fillSweeps(list) {
+    const sel = $('#r-sweep');
+    const opts = list.slice().reverse().map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)} (${s.state}, ${s.points_stored} points)</option>`).join('');
+    if (sel.innerHTML !== opts) sel.innerHTML = opts || '<option value="">no sweeps yet</option>';
+    if (this.sweepId) sel.value = String(this.sweepId);
+  }
+
+  refQuery() {
+    const r = $('#r-ref').value;
+    return r ? `?reference=${r}` : ''; // ESTIMATOR/PWM, [a-z0-9-] only
+  }
+
+  async load() {
+    const id = this.sweepId;
+    if (!id) return;
+    $('#r-summary').textContent = 'loading…';
+    try {
+      const points = await api('GET', `/api/sweeps/${id}/points`);
+      let analysis = null;
+      this.analysisFromDaemon = true;
+      try { analysis = await api('GET', `/api/sweeps/${id}/analysis${this.refQuery()}`, undefined, { quiet401: true }); } catch (e) {
+        if (e.status !== 404 && e.status !== 405) throw e;
+      }
+      if (!analysis) {
+        this.analysisFromDaemon = false;
+        const [estimator, pwm] = ($('#r-ref').value || 'encoder/capwm').split('/');
+        analysis = analyzeClient(points, { estimator, pwm });
+      }
+      if (id !== this.sweepId) return;
+      this.points = points;
+      this.analysis = analysis;
+      this.fillSelectors();
+      this.draw();
+      const p = analysis.points || {};
+      $('#r-summary').textContent = `Sweep #${id}: ${p.records ?? points.length} points, ${p.used ?? '?'} used`
+        + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`
+        + `${this.analysisFromDaemon ? '' : ' · analysis computed in the browser (the daemon has no /analysis route)'}`;
+    } catch (e) {
+      $('#r-summary').textContent = `cannot load sweep ${id}: ${e.message}`;
+    }
+  }
+
+  fillSelectors() {
+    const cfgs = analysisConfigs(this.analysis);
+    const fromPoints = [];
+    for (const p of this.points) if (!fromPoints.some((c) => key(c) === key(p))) fromPoints.push({ estimator: p.estimator, pwm: p.pwm });
+    const all = cfgs.length ? cfgs : fromPoints;
+    const setOpts = (sel, items, keep) => {
+      const prev = sel.value;
+      sel.innerHTML = items.map(([v, t]) => `<option value="${escapeHtml(String(v))}">${escapeHtml(t)}</option>`).join('');
+      if (keep && items.some(([v]) => String(v) === prev)) sel.value = prev;
+    };
+    // Default: an estimator with a position estimate when there is one (it has every plot).
+    const prevCfg = $('#r-config').value;
+    setOpts($('#r-config'), all.map((c) => [key(c), cfgLabel(c)]), true);
+    if (!prevCfg) {
+      const est = all.find((c) => c.estimator !== 'encoder');
+      if (est) $('#r-config').value = key(est);
+    }
+    const ref = this.analysis?.options?.reference;
+    setOpts($('#r-ref'), all.map((c) => [key(c), `reference: ${cfgLabel(c)}`]), false);
+    if (ref) $('#r-ref').value = key(ref);
+    const speeds = [...new Set(this.points.map((p) => p.speed_rpm))].sort((a, b) => a - b);
+    setOpts($('#r-speed'), speeds.map((s) => [s, `${s}`]), true);
+    this.fillLoads();
+  }
+
+  fillLoads() {
+    const speed = Number($('#r-speed').value);
+    const loads = [...new Set(this.points.filter((p) => p.speed_rpm === speed).map((p) => p.load_Nm))].sort((a, b) => a - b);
+    const sel = $('#r-load');
+    const prev = sel.value;
+    sel.innerHTML = loads.map((l) => `<option value="${l}">${l}</option>`).join('');
+    if (loads.map(String).includes(prev)) sel.value = prev;
+    this.draw();
+  }
+
+  draw() {
+    if (!this.analysis) return;
+    const [estimator, pwm] = ($('#r-config').value || 'encoder/capwm').split('/');
+    const cfg = { estimator, pwm };
+    const a = this.analysis;
+    const speed = Number($('#r-speed').value);
+    const load = Number($('#r-load').value);
+    this.cards.map.set(effMapOption(a, cfg));
+    this.cards.map.h.textContent = `Efficiency map η = P_m / P_dcM at the ME angle, ${cfgLabel(cfg)}`;
+    this.cards.traj.set(trajectoriesOption(a, cfg));
+    this.cards.traj.h.textContent = `MTPA (solid) and ME (dashed) angle against load, ${cfgLabel(cfg)}`;
+    this.cards.curve.set(curveOption(this.points, a, speed, load, analysisConfigs(a).length ? analysisConfigs(a) : [cfg]));
+    this.cards.curve.h.textContent = `I_m and P_dcM against angle at ${speed} rpm, ${load} N m`;
+    this.cards.poserr.set(posErrOption(a, cfg), { empty: estimator === 'encoder' ? 'the encoder has no position error: choose an estimator' : 'no position error in this sweep' });
+    this.cards.poserr.h.textContent = `Position error min / mean / max against load, ${cfgLabel(cfg)} (Figs. 6.13-6.15)`;
+    this.cards.delta.set(deltaOption(a), { empty: 'needs a second configuration measured at the reference\'s speeds and loads' });
+    this.cards.hist.set(histOption(a, cfg), { empty: estimator === 'encoder' ? 'the encoder estimates nothing: choose an estimator' : 'no estimates in this sweep' });
+    this.cards.hist.h.textContent = `Histograms, ${cfgLabel(cfg)} (Figs. 6.16-6.19)`;
+  }
+
+  async exportAnalysisCsv() {
+    if (!this.sweepId) return;
+    try {
+      await download(`/api/sweeps/${this.sweepId}/analysis?format=csv${this.refQuery().replace('?', '&')}`, `sweep-${this.sweepId}-analysis.csv`, 'text/csv');
+    } catch (e) {
+      if (e.status !== 404 && e.status !== 405) { this.app.toast(`export: ${e.message}`, true); return; }
+      // No CSV route: the curves (MTPA and ME per configuration, speed, load) from the analysis.
+      const head = 'estimator,pwm,speed_rpm,load_Nm,points,mtpa_angle_deg,mtpa_im_A,mtpa_pdcm_W,mtpa_efficiency,me_angle_deg,me_im_A,me_pdcm_W,me_efficiency';
+      const rows = (this.analysis?.curves?.entries || []).map((c) => [c.estimator, c.pwm, c.speed_rpm, c.load_Nm, c.points,
+        c.mtpa.angle_deg, c.mtpa.im_A, c.mtpa.pdcm_W, c.mtpa.efficiency, c.me.angle_deg, c.me.im_A, c.me.pdcm_W, c.me.efficiency].join(','));
+      saveBlob(new Blob([[head, ...rows].join('\n') + '\n'], { type: 'text/csv' }), `sweep-${this.sweepId}-analysis.csv`);
+    }
+  }
+}

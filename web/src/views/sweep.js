@@ -1,0 +1,472 @@
+// Sweep view: the builder (presets, dimensions, mode, configurations, measurement, estimate) and
+// the progress of the current sweep (per-point status, ETA, efficiency map and trajectories
+// filling in as points complete).
+import { api, ApiError } from '../api.js';
+import { ChartCard } from '../charts.js';
+import { ESTIMATORS, expandPlan, estimateLocal, fmtDuration, values } from '../plan.js';
+import { analyzeClient } from '../analysis.js';
+import { effMapOption, trajectoriesOption, cfgLabel } from './plots.js';
+import { escapeHtml } from './live.js';
+
+const $ = (s) => document.querySelector(s);
+const ACTIVE = ['running', 'pausing', 'paused', 'stopping'];
+
+// Presets the page knows when the daemon has no GET /api/presets.
+const BUILTIN_PRESETS = [
+  { name: 'thesis-grid', description: 'Thesis Sec. 6.3.2: 100..900 rpm x 0.5..3.5 N m x 40..76 deg, eight configurations (4522 points, ~3.8 h).',
+    plan: { preset: 'thesis-grid', dimensions: { speed_rpm: { from: 100, to: 900, step: 200 }, load_Nm: { from: 0.5, to: 3.5, step: 0.5 }, angle_deg: { from: 40, to: 76, step: 2 },
+      configurations: [{ estimator: 'encoder', pwm: 'capwm' }, { estimator: 'encoder', pwm: 'aspwm' }, { estimator: 'ekf-basic', pwm: 'aspwm' }, { estimator: 'ekf-rs', pwm: 'aspwm' },
+        { estimator: 'hfi', pwm: 'capwm' }, { estimator: 'eemf-const', pwm: 'capwm', min_speed_rpm: 500 }, { estimator: 'eemf-lut', pwm: 'capwm', min_speed_rpm: 500 }, { estimator: 'eemf-rls', pwm: 'capwm', min_speed_rpm: 500 }] } } },
+  { name: 'iec-61800-9-2', description: 'The eight IEC 61800-9-2 operating points (0 % speed measured at 100 rpm), 40..76 deg, encoder/CAPWM (152 points).',
+    plan: { preset: 'iec-61800-9-2', dimensions: { operating_points: [[100, 0.875], [100, 1.75], [100, 3.5], [750, 0.875], [750, 1.75], [750, 3.5], [1350, 1.75], [1350, 3.5]].map(([s, l]) => ({ speed_rpm: s, load_Nm: l })),
+      angle_deg: { from: 40, to: 76, step: 2 }, configurations: [{ estimator: 'encoder', pwm: 'capwm' }] } } },
+];
+const QUICK = { name: 'quick-twin-check', description: 'A small grid for a first look at the twin: 2 speeds x 2 loads x 3 angles, short window and gate (12 points, about a minute).',
+  plan: { name: 'quick twin check', dimensions: { speed_rpm: [300, 600], load_Nm: [1, 2], angle_deg: { from: 44, to: 64, step: 10 }, configurations: [{ estimator: 'encoder', pwm: 'capwm' }] },
+    window_s: 0.2, gate: { span_s: 0.2, min_settle_s: 0.2, timeout_s: 3 }, thermal: { enabled: false } } };
+
+// A list that is an even range of >= 3 values becomes {from, to, step}.
+function asRange(list) {
+  if (!Array.isArray(list)) return list;
+  if (list.length < 3) return list;
+  const step = Math.round((list[1] - list[0]) * 1e9) / 1e9;
+  if (!(step > 0)) return list;
+  for (let i = 2; i < list.length; i++) if (Math.abs(list[i] - list[i - 1] - step) > 1e-9) return list;
+  return { from: list[0], to: list[list.length - 1], step };
+}
+
+export class SweepView {
+  constructor(app) {
+    this.app = app;
+    this.presets = [];
+    this.base = {};
+    this.current = null;       // {id, meta, plan, points, analysis, expanded}
+    this.pace = [];            // [wall ms, done] while running, for the ETA
+    this.buildDims();
+    this.mapCard = new ChartCard($('[data-chart="p-map"]'), { title: 'Efficiency map (ME angle)' });
+    this.trajCard = new ChartCard($('[data-chart="p-traj"]'), { title: 'MTPA / ME trajectories' });
+    this.loadPresets(false);
+
+    const form = $('#builder');
+    form.addEventListener('input', (e) => { if (e.target.id !== 'b-preset') this.changed(); });
+    form.addEventListener('change', (e) => { if (e.target.id !== 'b-preset') this.changed(); });
+    $('#b-preset').addEventListener('change', () => this.applyPreset($('#b-preset').value));
+    $('#b-add-config').addEventListener('click', () => { this.addConfig({ estimator: 'encoder', pwm: 'capwm' }); this.changed(); });
+    form.addEventListener('submit', (e) => { e.preventDefault(); this.create(true); });
+    $('#b-create').addEventListener('click', () => this.create(false));
+    for (const a of ['pause', 'resume', 'abort']) $(`#p-${a}`).addEventListener('click', () => this.action(a));
+    $('#p-restart').addEventListener('click', () => this.action('start'));
+
+    app.on('view', ({ view, arg }) => {
+      this.visible = view === 'sweep';
+      if (this.visible && arg) this.select(arg);
+      if (this.visible) this.refreshCurrent(true);
+    });
+    app.on('status', (st) => this.onStatus(st));
+    app.on('sweep-progress', (s) => this.onProgress(s));
+    app.on('refresh', () => { this.refreshCurrent(true); if (!this.presetsFromDaemon) this.loadPresets(true); });
+    app.on('role', () => this.renderButtons());
+    setInterval(() => { if (this.visible && this.current && ACTIVE.includes(this.current.state)) this.refreshCurrent(false); }, 2000);
+  }
+
+  // ---- builder ----------------------------------------------------------------------------------
+  buildDims() {
+    const fs = $('#b-dims');
+    fs.insertAdjacentHTML('beforeend', `
+      <label class="check"><input type="checkbox" id="b-oppoints"> Explicit operating points (speed, load pairs) instead of a grid</label>
+      ${['speed_rpm:Speed:rpm', 'load_Nm:Load:N m', 'angle_deg:Angle:deg'].map((d) => {
+        const [key, label, unit] = d.split(':');
+        return `<div class="dimrow" data-dim="${key}">
+          <span class="lbl" id="lbl-${key}">${label} <span class="unit">${unit}</span></span>
+          <select aria-label="${label}: list or range" data-role="kind"><option value="range">range</option><option value="list">list</option></select>
+          <div class="vals">
+            <label>from<input data-role="from" type="number" step="any" aria-describedby="lbl-${key}"></label>
+            <label>to<input data-role="to" type="number" step="any" aria-describedby="lbl-${key}"></label>
+            <label>step<input data-role="step" type="number" step="any" aria-describedby="lbl-${key}"></label>
+          </div>
+          <div class="vals list" hidden><label>values<input data-role="list" type="text" inputmode="decimal" placeholder="e.g. 300, 600" title="comma-separated values" aria-describedby="lbl-${key}"></label></div>
+        </div>`;
+      }).join('')}
+      <label id="b-points-wrap" hidden>Operating points: one "speed_rpm load_Nm [label]" per line<textarea id="b-points" rows="5" spellcheck="false"></textarea></label>`);
+    for (const row of fs.querySelectorAll('.dimrow')) {
+      row.querySelector('[data-role="kind"]').addEventListener('change', (e) => this.setKind(row, e.target.value));
+    }
+    $('#b-oppoints').addEventListener('change', () => this.syncVisibility());
+    for (const r of document.querySelectorAll('input[name="b-mode"]')) r.addEventListener('change', () => this.syncVisibility());
+  }
+
+  setKind(row, kind) {
+    row.querySelector('[data-role="kind"]').value = kind;
+    const [range, list] = row.querySelectorAll('.vals');
+    range.hidden = kind !== 'range';
+    list.hidden = kind !== 'list';
+  }
+
+  setDim(key, dim) {
+    const row = document.querySelector(`.dimrow[data-dim="${key}"]`);
+    const d = asRange(dim);
+    if (d && !Array.isArray(d)) {
+      this.setKind(row, 'range');
+      row.querySelector('[data-role="from"]').value = d.from;
+      row.querySelector('[data-role="to"]').value = d.to;
+      row.querySelector('[data-role="step"]').value = d.step;
+      row.querySelector('[data-role="list"]').value = values(d).join(', ');
+    } else {
+      this.setKind(row, 'list');
+      row.querySelector('[data-role="list"]').value = (d || []).join(', ');
+    }
+  }
+
+  getDim(key) {
+    const row = document.querySelector(`.dimrow[data-dim="${key}"]`);
+    if (row.querySelector('[data-role="kind"]').value === 'range') {
+      const n = (r) => Number(row.querySelector(`[data-role="${r}"]`).value);
+      return { from: n('from'), to: n('to'), step: n('step') };
+    }
+    return row.querySelector('[data-role="list"]').value.split(/[,;\s]+/).filter(Boolean).map(Number);
+  }
+
+  syncVisibility() {
+    const adaptive = this.mode() === 'adaptive';
+    const pts = $('#b-oppoints').checked;
+    document.querySelector('.dimrow[data-dim="angle_deg"]').hidden = adaptive;
+    document.querySelector('.dimrow[data-dim="speed_rpm"]').hidden = pts;
+    document.querySelector('.dimrow[data-dim="load_Nm"]').hidden = pts;
+    $('#b-points-wrap').hidden = !pts;
+    $('#b-adaptive').hidden = !adaptive;
+  }
+
+  mode() { return document.querySelector('input[name="b-mode"]:checked').value; }
+
+  addConfig(c) {
+    const row = document.createElement('div');
+    row.className = 'cfgrow';
+    const n = $('#b-configs').children.length + 1;
+    row.innerHTML = `<select aria-label="Configuration ${n}: estimator" data-role="est">${ESTIMATORS.map((e) => `<option ${e === c.estimator ? 'selected' : ''}>${e}</option>`).join('')}</select>
+      <select aria-label="Configuration ${n}: PWM" data-role="pwm"><option value="capwm" ${c.pwm === 'capwm' ? 'selected' : ''}>CAPWM</option><option value="aspwm" ${c.pwm === 'aspwm' ? 'selected' : ''}>ASPWM</option></select>
+      <button type="button" class="small" aria-label="Remove configuration ${n}">Remove</button>`;
+    row.dataset.min = c.min_speed_rpm ?? '';
+    row.dataset.max = c.max_speed_rpm ?? '';
+    row.querySelector('button').addEventListener('click', () => { row.remove(); this.changed(); });
+    row.querySelector('[data-role="est"]').addEventListener('change', () => { row.dataset.min = ''; row.dataset.max = ''; });
+    $('#b-configs').append(row);
+  }
+
+  async loadPresets(ask) {
+    let list = null;
+    if (ask) try { list = await api('GET', '/api/presets', undefined, { quiet401: true }); } catch { /* not there yet */ }
+    this.presetsFromDaemon = Array.isArray(list) && list.length > 0;
+    if (ask && !this.presetsFromDaemon && this.presets.length) return; // keep the form as it is
+    const keep = this.presets.length ? $('#b-preset').value : null;
+    this.presets = [QUICK, ...(this.presetsFromDaemon ? list : BUILTIN_PRESETS)];
+    $('#b-preset').innerHTML = `<option value="">custom (start from the current form)</option>`
+      + this.presets.map((p) => `<option value="${escapeHtml(p.name)}">${escapeHtml(p.name)}</option>`).join('');
+    if (keep !== null) { $('#b-preset').value = keep; return; } // the user's form stays
+    $('#b-preset').value = QUICK.name;
+    this.applyPreset(QUICK.name);
+  }
+
+  applyPreset(name) {
+    const p = this.presets.find((x) => x.name === name);
+    $('#b-preset-desc').textContent = p ? p.description || '' : 'Edit any field below.';
+    if (!p) { this.changed(); return; }
+    this.fillForm(p.plan, name);
+  }
+
+  fillForm(plan, name) {
+    const { preset, ...base } = plan;
+    this.base = JSON.parse(JSON.stringify(base));
+    const d = plan.dimensions || {};
+    $('#b-name').value = plan.name || name || 'sweep';
+    document.querySelector(`input[name="b-mode"][value="${plan.mode === 'adaptive' ? 'adaptive' : 'grid'}"]`).checked = true;
+    $('#b-oppoints').checked = !!d.operating_points;
+    if (d.operating_points) $('#b-points').value = d.operating_points.map((p) => `${p.speed_rpm} ${p.load_Nm}${p.label ? ` ${p.label}` : ''}`).join('\n');
+    this.setDim('speed_rpm', d.speed_rpm || [300, 600]);
+    this.setDim('load_Nm', d.load_Nm || [1, 2]);
+    this.setDim('angle_deg', d.angle_deg || { from: 40, to: 76, step: 2 });
+    $('#b-configs').innerHTML = '';
+    for (const c of d.configurations || [{ estimator: 'encoder', pwm: 'capwm' }]) this.addConfig(c);
+    const a = plan.adaptive || {};
+    $('#b-br-from').value = a.bracket_deg?.[0] ?? 40;
+    $('#b-br-to').value = a.bracket_deg?.[1] ?? 76;
+    $('#b-tol').value = a.tolerance_deg ?? 1;
+    $('#b-maxev').value = a.max_evaluations ?? 7;
+    $('#b-stencil').value = a.stencil_deg ?? 6;
+    $('#b-window').value = plan.window_s ?? 1;
+    $('#b-span').value = plan.gate?.span_s ?? 0.5;
+    $('#b-settle').value = plan.gate?.min_settle_s ?? 0.5;
+    $('#b-timeout').value = plan.gate?.timeout_s ?? 30;
+    $('#b-thermal').checked = plan.thermal?.enabled ?? true;
+    this.syncVisibility();
+    this.changed();
+  }
+
+  planFromForm() {
+    const plan = JSON.parse(JSON.stringify(this.base || {}));
+    delete plan.preset;
+    plan.name = $('#b-name').value.trim() || 'sweep';
+    plan.mode = this.mode();
+    const dims = {};
+    if ($('#b-oppoints').checked) {
+      dims.operating_points = $('#b-points').value.split('\n').map((l) => l.trim()).filter(Boolean).map((l) => {
+        const [s, t, ...label] = l.split(/\s+/);
+        const p = { speed_rpm: Number(s), load_Nm: Number(t) };
+        if (label.length) p.label = label.join(' ');
+        return p;
+      });
+    } else {
+      dims.speed_rpm = this.getDim('speed_rpm');
+      dims.load_Nm = this.getDim('load_Nm');
+    }
+    if (plan.mode === 'grid') dims.angle_deg = this.getDim('angle_deg');
+    dims.configurations = [...$('#b-configs').children].map((row) => {
+      const c = { estimator: row.querySelector('[data-role="est"]').value, pwm: row.querySelector('[data-role="pwm"]').value };
+      if (row.dataset.min !== '') c.min_speed_rpm = Number(row.dataset.min);
+      if (row.dataset.max !== '' && row.dataset.max !== 'null') c.max_speed_rpm = Number(row.dataset.max);
+      return c;
+    });
+    plan.dimensions = dims;
+    if (plan.mode === 'adaptive') {
+      plan.adaptive = { ...(plan.adaptive || {}), bracket_deg: [Number($('#b-br-from').value), Number($('#b-br-to').value)],
+        tolerance_deg: Number($('#b-tol').value), max_evaluations: Number($('#b-maxev').value), stencil_deg: Number($('#b-stencil').value) };
+    } else {
+      delete plan.adaptive;
+    }
+    plan.window_s = Number($('#b-window').value);
+    plan.gate = { ...(plan.gate || {}), span_s: Number($('#b-span').value), min_settle_s: Number($('#b-settle').value), timeout_s: Number($('#b-timeout').value) };
+    plan.thermal = { ...(plan.thermal || {}), enabled: $('#b-thermal').checked };
+    return plan;
+  }
+
+  changed() {
+    const plan = this.planFromForm();
+    $('#b-json').textContent = JSON.stringify(plan, null, 2);
+    clearTimeout(this.estTimer);
+    this.estTimer = setTimeout(() => this.estimate(plan), 250);
+  }
+
+  async estimate(plan) {
+    const el = $('#b-estimate');
+    const seq = (this.estSeq = (this.estSeq || 0) + 1);
+    let text, bad = false;
+    try {
+      const r = await api('POST', '/api/sweeps/estimate', plan, { quiet401: true });
+      text = `${r.points}${r.upper_bound || plan.mode === 'adaptive' ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time`;
+      this.lastEstimate = r;
+    } catch (e) {
+      if (e instanceof ApiError && (e.status === 404 || e.status === 405)) {
+        try {
+          const r = estimateLocal(plan);
+          text = `${r.points}${r.upper_bound ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time (estimated in the browser)`;
+          this.lastEstimate = r;
+        } catch (err) { text = `cannot estimate: ${err.message}`; bad = true; }
+      } else if (e.code === 'bad_plan' || e.status === 400) {
+        text = `Plan problems: ${e.message}`;
+        bad = true;
+      } else {
+        text = `cannot estimate: ${e.message}`;
+        bad = true;
+      }
+    }
+    if (seq !== this.estSeq) return;
+    el.textContent = text;
+    el.classList.toggle('bad', bad);
+    el.dataset.points = bad ? '' : String(this.lastEstimate?.points ?? '');
+  }
+
+  async create(start) {
+    const plan = this.planFromForm();
+    let s;
+    try {
+      s = await this.app.command('POST', '/api/sweeps', plan, start ? null : 'Sweep created');
+    } catch { return; }
+    this.app.refreshSweeps();
+    this.select(s.id, s);
+    if (start) await this.action('start');
+  }
+
+  // ---- progress --------------------------------------------------------------------------------
+  async action(a) {
+    if (!this.current) return;
+    try {
+      await this.app.command('POST', `/api/sweeps/${this.current.id}/${a}`, {}, `Sweep ${this.current.id}: ${a}`);
+      this.pace = [];
+      this.followRunning = true;
+    } catch { /* toast shown */ }
+    this.refreshCurrent(true);
+    this.app.refreshSweeps();
+  }
+
+  select(id, meta) {
+    if (this.current?.id !== id) {
+      this.current = { id, meta: meta || null, points: [], analysis: null, state: meta?.state };
+      this.pace = [];
+      this.lastDone = -1;
+    }
+    this.refreshCurrent(true);
+  }
+
+  onStatus(st) {
+    const s = st.sweep;
+    if (!s) return;
+    // Follow the running sweep (started here, from another page or a CLI).
+    if (ACTIVE.includes(s.state) && this.current?.id !== s.id) this.select(s.id);
+    if (!this.current && s.id) this.select(s.id);
+    if (this.current?.id === s.id) this.onProgress(s);
+  }
+
+  onProgress(s) {
+    if (!this.current || this.current.id !== s.id) { if (s.id && ACTIVE.includes(s.state)) this.select(s.id); return; }
+    const c = this.current;
+    if (c.state !== s.state) this.app.refreshSweeps();
+    c.state = s.state;
+    c.done = s.done;
+    c.total = s.total;
+    if (s.eta_s !== undefined) c.eta_s = s.eta_s;
+    if (s.error) c.error = s.error;
+    if (ACTIVE.includes(s.state)) {
+      this.pace.push([performance.now(), s.done]);
+      if (this.pace.length > 200) this.pace.shift();
+    }
+    if (s.done !== this.lastDone) {
+      this.lastDone = s.done;
+      this.loadData();
+    }
+    this.renderProgress();
+  }
+
+  async refreshCurrent(full) {
+    if (!this.current) {
+      // Nothing chosen: the most recent sweep of the history.
+      const last = this.app.sweeps?.[this.app.sweeps.length - 1];
+      if (last) this.select(last.id, last); else this.renderProgress();
+      return;
+    }
+    const id = this.current.id;
+    try {
+      const meta = await api('GET', `/api/sweeps/${id}`);
+      if (this.current?.id !== id) return;
+      this.current.meta = meta;
+      this.current.plan = meta.plan;
+      if (!this.current.expanded) this.current.expanded = expandPlan(meta.plan);
+      const run = this.app.status?.sweep;
+      if (!(run && run.id === id)) {
+        this.current.state = meta.state;
+        this.current.done = meta.points_stored;
+        this.current.total = meta.total_points;
+        this.current.error = meta.last_error;
+      } else if (this.current.done == null) {
+        this.onProgress(run);
+      }
+      if (full || this.current.done !== this.lastLoadedDone) await this.loadData();
+    } catch (e) { if (e.status === 404) this.current = null; }
+    this.renderProgress();
+  }
+
+  async loadData() {
+    if (!this.current || this.loading) { this.reload = true; return; }
+    this.loading = true;
+    const c = this.current;
+    try {
+      const points = await api('GET', `/api/sweeps/${c.id}/points`);
+      c.points = points;
+      this.lastLoadedDone = c.done;
+      let analysis = null;
+      try { analysis = await api('GET', `/api/sweeps/${c.id}/analysis`, undefined, { quiet401: true }); } catch (e) {
+        if (!(e.status === 404 || e.status === 405)) console.warn('analysis', e.message);
+      }
+      // Fallback: the route is missing (404 "not_found" of the router, not of the sweep).
+      c.analysis = analysis || analyzeClient(points);
+      this.renderProgress();
+      this.renderCharts();
+    } catch (e) {
+      console.warn('points', e.message);
+    } finally {
+      this.loading = false;
+      if (this.reload) { this.reload = false; setTimeout(() => this.loadData(), 300); }
+    }
+  }
+
+  eta() {
+    const c = this.current;
+    if (c.eta_s != null) return c.eta_s;
+    if (!ACTIVE.includes(c.state) || this.pace.length < 2) return null;
+    const [t0, d0] = this.pace[0];
+    const [t1, d1] = this.pace[this.pace.length - 1];
+    if (d1 <= d0 || t1 <= t0) return null;
+    return ((c.total - d1) * (t1 - t0)) / (d1 - d0) / 1000;
+  }
+
+  renderButtons() {
+    const c = this.current;
+    const op = this.app.isOperator;
+    const st = c?.state;
+    $('#p-pause').disabled = !op || !c || st !== 'running';
+    $('#p-resume').disabled = !op || !c || st !== 'paused';
+    $('#p-abort').disabled = !op || !c || !ACTIVE.includes(st);
+    $('#p-restart').disabled = !op || !c || ACTIVE.includes(st) || st === 'completed';
+    $('#b-start').disabled = !op;
+    $('#b-create').disabled = !op;
+  }
+
+  renderProgress() {
+    const c = this.current;
+    this.renderButtons();
+    if (!c) { $('#p-line').textContent = 'No sweep yet: build one on the left.'; return; }
+    const total = c.total ?? c.meta?.total_points ?? 0;
+    const done = c.done ?? c.meta?.points_stored ?? 0;
+    const pct = total ? Math.min(100, Math.floor((100 * done) / total)) : 0;
+    const shownPct = c.state === 'completed' ? 100 : pct;
+    $('#p-title').textContent = `#${c.id} ${c.meta?.name || ''}`;
+    $('#p-bar span').style.width = `${shownPct}%`;
+    $('#p-bar').setAttribute('aria-valuenow', String(shownPct));
+    $('#p-pct').textContent = `${shownPct} %`;
+    $('#p-pct').dataset.pct = String(shownPct);
+    const eta = this.eta();
+    const parts = [`<span class="state ${c.state}" id="p-state">${c.state || '?'}</span>`, `${done} / ${total} points`];
+    if (ACTIVE.includes(c.state)) parts.push(`ETA ${eta == null ? 'estimating…' : fmtDuration(eta)}`);
+    if (c.meta?.plan?.mode === 'adaptive') parts.push('adaptive: total is an upper bound');
+    if (c.error) parts.push(`<span class="error">${escapeHtml(c.error)}</span>`);
+    $('#p-line').innerHTML = parts.join(' · ');
+    this.renderCells(total);
+  }
+
+  renderCells(total) {
+    const c = this.current;
+    const byIndex = new Map((c.points || []).map((p) => [p.point_index, p]));
+    const exp = c.expanded;
+    const n = Math.min(total || 0, 5000);
+    const active = ACTIVE.includes(c.state) && c.state !== 'paused';
+    let firstMissing = -1;
+    if (active && exp) for (let i = 0; i < n; i++) if (!byIndex.has(i)) { firstMissing = i; break; }
+    const host = $('#p-cells');
+    if (host.childElementCount !== n) host.innerHTML = Array.from({ length: n }, (_, i) => `<span class="c" data-i="${i}"></span>`).join('');
+    const cells = host.children;
+    for (let i = 0; i < n; i++) {
+      const p = byIndex.get(i);
+      let cls = 'c pending';
+      let title;
+      const e = exp?.[i];
+      const where = e ? `${e.speed_rpm} rpm, ${e.load_Nm} N m, ${e.angle_deg}°, ${e.estimator}/${e.pwm}` : `point ${i}`;
+      if (p) {
+        cls = p.fault ? 'c bad' : p.unstable || p.voltage_limited ? 'c warn' : 'c done';
+        title = `#${i} ${p.speed_rpm} rpm, ${p.load_Nm} N m, ${p.angle_deg}°, ${p.estimator}/${p.pwm}: I_m ${p.im_A?.toFixed(3)} A, P_dcM ${p.pdcm_W?.toFixed(1)} W, η ${(100 * p.efficiency).toFixed(1)} %${p.fault ? `, fault ${p.fault}` : ''}${p.unstable ? ', unstable' : ''}${p.voltage_limited ? ', voltage limited' : ''}`;
+      } else if (i === firstMissing) { cls = 'c active'; title = `#${i} ${where}: measuring`; }
+      else title = `#${i} ${where}: pending`;
+      if (cells[i].className !== cls) cells[i].className = cls;
+      cells[i].title = title;
+    }
+    host.dataset.done = String((c.points || []).length);
+  }
+
+  renderCharts() {
+    const a = this.current?.analysis;
+    const cfg = a?.efficiency_map?.entries?.[0] || a?.curves?.entries?.[0];
+    this.mapCard.set(effMapOption(a, cfg), { empty: 'fills in as curves complete' });
+    this.trajCard.set(trajectoriesOption(a, cfg), { empty: 'fills in as curves complete' });
+    if (cfg) {
+      this.mapCard.h.textContent = `Efficiency map, ${cfgLabel(cfg)}`;
+      this.trajCard.h.textContent = `MTPA / ME trajectories, ${cfgLabel(cfg)}`;
+    }
+  }
+}
