@@ -154,6 +154,11 @@ int serve_command(const std::vector<std::string>& argv) {
   auto hub = std::make_shared<http::WsHub>(io, bench, router, [&tokens](std::string_view t) { return tokens.authenticate(t); },
                                            synbench::kVersion);
   server.set_websocket(hub, options.allow_origins);
+  // Weak: the hub's timer must not outlive the io_context declared after `metrics`.
+  metrics.set_ws_source([weak = std::weak_ptr<http::WsHub>(hub)] {
+    const auto h = weak.lock();
+    return h ? http::WsCounts{h->session_count(), h->dropped()} : http::WsCounts{};
+  });
   hub->start();
   if (auto e = server.listen(host, port)) {
     std::cerr << "synbench serve: cannot listen on " << host << ":" << port << ": " << e.message() << "\n";

@@ -145,7 +145,8 @@ nlohmann::json status_json(const BenchStatus& s) {
   return j;
 }
 
-std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status) {
+std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
+                            const std::optional<WsCounts>& ws) {
   std::ostringstream o;
   auto gauge = [&](const char* name, const char* help, double v) {
     o << "# HELP " << name << " " << help << "\n# TYPE " << name << " gauge\n" << name << " " << v << "\n";
@@ -167,6 +168,11 @@ std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint6
     << "synbench_loop_overruns_total " << s.overruns << "\n";
   o << "# HELP synbench_http_requests_total HTTP requests answered, by status.\n# TYPE synbench_http_requests_total counter\n";
   for (const auto& [code, n] : http_by_status) o << "synbench_http_requests_total{status=\"" << code << "\"} " << n << "\n";
+  if (ws) {
+    gauge("synbench_ws_clients", "WebSocket clients connected.", static_cast<double>(ws->clients));
+    o << "# HELP synbench_ws_dropped_total WebSocket clients dropped for not reading (queue bound or write stall).\n"
+      << "# TYPE synbench_ws_dropped_total counter\nsynbench_ws_dropped_total " << ws->dropped << "\n";
+  }
   return o.str();
 }
 
@@ -191,7 +197,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
               [bench, metrics](const Request&) {
                 Response r;
                 r.content_type = "text/plain; version=0.0.4";
-                r.body = prometheus_text(bench->status(), metrics->by_status());
+                r.body = prometheus_text(bench->status(), metrics->by_status(), metrics->ws());
                 return r;
               }});
   router.add({"GET", "/api/bench/status", Role::viewer,

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <string>
 #include <variant>
@@ -17,14 +19,31 @@
 namespace synbench::http {
 
 // Request counts by status, for /metrics.
+// WebSocket clients connected now and dropped so far (slow readers), for /metrics.
+struct WsCounts {
+  std::size_t clients = 0;
+  std::uint64_t dropped = 0;
+};
+
 class HttpMetrics {
  public:
   void count(int status);
   std::map<int, std::uint64_t> by_status() const;
+  // The WebSocket hub's counts, once it exists (it is built after the routes).
+  void set_ws_source(std::function<WsCounts()> source) {
+    std::lock_guard lock(mutex_);
+    ws_source_ = std::move(source);
+  }
+  std::optional<WsCounts> ws() const {
+    std::lock_guard lock(mutex_);
+    if (!ws_source_) return std::nullopt;
+    return ws_source_();
+  }
 
  private:
   mutable std::mutex mutex_;
   std::map<int, std::uint64_t> by_status_;
+  std::function<WsCounts()> ws_source_;
 };
 
 // One operator commands the bench at a time. The first operator command claims the lock; another
@@ -84,6 +103,7 @@ void add_api_routes(Router& router, ApiContext ctx);
 std::variant<nlohmann::json, Response> parse_json_object(const std::string& body);
 
 nlohmann::json status_json(const BenchStatus& s);
-std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status);
+std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
+                            const std::optional<WsCounts>& ws = std::nullopt);
 
 }  // namespace synbench::http

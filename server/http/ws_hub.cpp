@@ -140,7 +140,14 @@ void WsHub::on_tick() {
     max_seq = std::max(max_seq, e.seq);
   }
   last_event_seq_ = max_seq;
-  const std::string state_key = std::to_string(s.enabled) + phase_name(s.phase) + std::to_string(s.trip.has_value());
+  // A state message whenever what GET /api/bench/status shows changes, telemetry aside: enable,
+  // stop, phase, trip, setpoints, mode, sweep state, a new event. So a page need not poll.
+  const std::string state_key =
+      std::to_string(s.enabled) + std::to_string(s.stopping) + phase_name(s.phase) + std::to_string(s.trip.has_value()) +
+      "|" + std::to_string(s.setpoints.speed_rpm) + "," + std::to_string(s.setpoints.load_Nm) + "," +
+      std::to_string(s.setpoints.angle_deg) + "|" + std::string(drivers::name(s.mode.estimator)) +
+      std::string(drivers::name(s.mode.pwm)) + "|" + (s.sweep ? std::to_string(s.sweep->id) + s.sweep->state : "") + "|" +
+      std::to_string(max_seq);
   if (build && primed_ && state_key != last_state_key_) tick->events.push_back(share(state_message(s)));
   last_state_key_ = state_key;
 

@@ -306,6 +306,8 @@ def main():
         check(s == 409 and error_of(data)[0] == "bench_enabled", "mode change refused while enabled")
         s, data, _ = d.request("GET", "/metrics")
         check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
+        check("synbench_ws_clients 0" in data.decode() and "synbench_ws_dropped_total 0" in data.decode(),
+              "metrics counts WebSocket clients and drops")
 
         # The control lock: op holds it since its first command; another operator is refused,
         # but may always E-stop.
