@@ -23,6 +23,8 @@ struct AnalysisOptions {
   bool exclude_unstable = true;
   bool exclude_faulted = true;
   bool exclude_voltage_limited = true;
+  // Measured on the low-speed fallback: not the configuration's own estimator.
+  bool exclude_below_min_speed = true;
   // Histogram bin widths of the thesis (Figs. 6.16 to 6.19).
   double pos_err_bin_deg = 0.5;
   double ld_err_bin_pct = 5.0;

@@ -208,6 +208,8 @@ void PointProcedure::read_results() {
   r.window_s = m.gate_s > 0 ? m.gate_s : w.window_s;
   r.samples = w.samples;
   r.voltage_limited = w.voltage_limited_fraction > 0;
+  r.fallback_fraction = w.fallback_fraction;
+  r.below_min_speed = w.fallback_fraction > 0.5;
   if (w.fault != drivers::Fault::none) r.fault = std::string(drivers::fault_name(w.fault));
   if (dev_.truth) r.truth = dev_.truth->read_truth_window();
   has_record_ = true;

@@ -52,6 +52,8 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["voltage_limited"] = r.voltage_limited;
   j["unstable"] = r.unstable;
   j["fault"] = r.fault ? nlohmann::ordered_json(*r.fault) : nlohmann::ordered_json(nullptr);
+  j["below_min_speed"] = r.below_min_speed;
+  j["fallback_fraction"] = r.fallback_fraction;
   if (r.truth) {
     const auto& t = *r.truth;
     j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},

@@ -30,6 +30,10 @@ struct PointRecord {
   // flags
   bool voltage_limited = false, unstable = false;
   std::optional<std::string> fault;
+  // Below the selected estimator's minimum speed the drive ran on its low-speed fallback (HFI or
+  // the encoder) for most of the window: the estimator fields describe the fallback, not it.
+  bool below_min_speed = false;
+  double fallback_fraction = 0;  // share of the window's samples on the fallback, 0..1
   // emulator only: the plant's own values over the window
   std::optional<drivers::TruthWindow> truth;
 };

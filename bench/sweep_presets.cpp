@@ -30,6 +30,7 @@ std::string rpm(double v) {
 PlannedConfiguration with_thesis_speed_range(Configuration c) {
   PlannedConfiguration p{c, 0, std::nullopt};
   if (is_eemf(c.estimator)) p.min_speed_rpm = kThesisEemfMinSpeed_rpm;
+  if (c.estimator == Estimator::hfi) p.max_speed_rpm = kThesisHfiMaxSpeed_rpm;
   return p;
 }
 
@@ -58,7 +59,8 @@ SweepPlan thesis_grid_plan() {
   p.notes = {
       "Thesis Sec. 6.3.2: 100..900 rpm step 200, 0.5..3.5 N m step 0.5, 40..76 deg step 2 (19 angles; "
       "the thesis also says 23, which that range and step cannot give).",
-      "EEMF variants only from 500 rpm, as in the thesis (HFI or the encoder below)."};
+      "EEMF variants only from 500 rpm, as in the thesis (HFI or the encoder below); HFI, the low-speed "
+      "method, only up to 300 rpm."};
   return p;
 }
 

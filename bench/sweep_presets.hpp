@@ -24,13 +24,17 @@ inline constexpr double kThesisLoadFrom_Nm = 0.5, kThesisLoadTo_Nm = 3.5, kThesi
 inline constexpr double kThesisAngleFrom_deg = 40, kThesisAngleTo_deg = 76, kThesisAngleStep_deg = 2;
 // The EEMF variants were measured only from this speed (HFI or the encoder below).
 inline constexpr double kThesisEemfMinSpeed_rpm = 500;
+// HFI is the low-speed method (physics.md Sec. 8: "CAPWM, low speed"; the thesis measured it at
+// 100 and 300 rpm, where the EEMF variants hand over to it). [assumed] upper end of the range:
+// above it the twin's HFI loses lock at every point (docs/estimators.md).
+inline constexpr double kThesisHfiMaxSpeed_rpm = 300;
 
 // The eight configurations of the thesis (physics.md Sec. 8): encoder with CAPWM (the reference)
 // and ASPWM, EKF-BASIC and EKF-RS with ASPWM, HFI and the three EEMF variants with CAPWM; the
 // EEMF variants restricted to >= 500 rpm.
 std::vector<PlannedConfiguration> thesis_configurations();
 // The thesis restriction applied to a configuration a plan lists with the thesis-grid preset:
-// EEMF variants get min_speed_rpm = 500 unless the plan sets it.
+// EEMF variants get min_speed_rpm = 500, HFI max_speed_rpm = 300, unless the plan sets them.
 PlannedConfiguration with_thesis_speed_range(Configuration c);
 
 SweepPlan thesis_grid_plan();

@@ -89,8 +89,18 @@ CREATE TABLE events (
 CREATE INDEX events_by_sweep ON events (sweep_id, id);
 )sql";
 
+// Version 2: the estimator's minimum-speed flag and the share of the window on the low-speed
+// fallback. Added columns follow measured_at; rows from version 1 ran without the flag (0). The
+// default is the integer 0 (SQLite stores a 0.0 default in an ANY column as an integer, so the
+// CHECK admits it; bound values are always reals, and an integer 0 reads back as 0.0).
+constexpr std::string_view kSchemaV2 = R"sql(
+ALTER TABLE points ADD COLUMN below_min_speed INTEGER NOT NULL DEFAULT 0 CHECK (below_min_speed IN (0, 1));
+ALTER TABLE points ADD COLUMN fallback_fraction ANY DEFAULT 0 CHECK (typeof(fallback_fraction) IN ('real', 'integer', 'null'));
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
+    Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
 };
 
 struct Header {

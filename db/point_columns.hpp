@@ -27,7 +27,7 @@ struct RecordColumn {
   Member member;
 };
 
-inline const std::array<RecordColumn, 35> kRecordColumns{{
+inline const std::array<RecordColumn, 37> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
@@ -63,6 +63,8 @@ inline const std::array<RecordColumn, 35> kRecordColumns{{
     {"voltage_limited", &PointRecord::voltage_limited},
     {"unstable", &PointRecord::unstable},
     {"fault", &PointRecord::fault},
+    {"below_min_speed", &PointRecord::below_min_speed},    // schema version 2
+    {"fallback_fraction", &PointRecord::fallback_fraction},
 }};
 
 }  // namespace synbench::db::detail

@@ -27,6 +27,9 @@ struct SynrmTelemetry {
   double pac_W = 0;  // 1.5 (ud id + uq iq): the drive's own estimate of its output power
   double temp_C = 0;
   bool voltage_limited = false;
+  // Estimated minus encoder electrical angle, wrapped to (-90, 90] deg, at the last control
+  // period; empty when the encoder is the position source.
+  std::optional<double> pos_err_deg;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;
 };
@@ -38,6 +41,9 @@ struct SynrmWindow {
   double speed_meas_rpm = 0;  // from encoder counts over the window
   double im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0, udc_V = 0, temp_C = 0;
   double voltage_limited_fraction = 0;
+  // Fraction of the samples in which a low-speed fallback gave the angle instead of the selected
+  // estimator (an EEMF observer below its minimum speed hands over to HFI or the encoder).
+  double fallback_fraction = 0;
   // Estimator outputs; empty when the position source is the encoder.
   std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
   std::optional<double> ld_est_H, lq_est_H, rs_est_ohm;

@@ -105,6 +105,7 @@ struct FirmwareParams {
   double adc_range_A = 8.0;
   double current_limit_A = 4.0;
   double speed_ramp_rpm_per_s = 1000.0;
+  double sensorless_angle_slew_deg_per_s = 30.0;
   double telemetry_filter_s = 0.05;
   double max_speed_rpm = 1500.0;
   double overspeed_trip_rpm = 1800.0;
@@ -119,7 +120,7 @@ struct FirmwareParams {
 struct HfiConfig {
   double voltage_V = 20.0;
   double frequency_Hz = 500.0;
-  double bandpass_bandwidth_Hz = 25.0;
+  double bandpass_bandwidth_Hz = 200.0;  // thesis 25 Hz; docs/estimators.md
   double pll_bandwidth_Hz = 10.0;
 };
 

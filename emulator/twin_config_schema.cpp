@@ -144,6 +144,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("firmware.adc_range_A", &f.adc_range_A, "Sec. 6.1", "current ADC full scale (+/-)");
   b.pos("firmware.current_limit_A", &f.current_limit_A, "assumed", "speed controller output limit (peak)", A);
   b.pos("firmware.speed_ramp_rpm_per_s", &f.speed_ramp_rpm_per_s, "assumed", "speed setpoint ramp", A);
+  b.pos("firmware.sensorless_angle_slew_deg_per_s", &f.sensorless_angle_slew_deg_per_s, "assumed",
+        "current-angle rate limit while an estimator is the position source", A);
   b.pos("firmware.telemetry_filter_s", &f.telemetry_filter_s, "assumed", "time constant of telemetry low-pass filters", A);
   b.pos("firmware.max_speed_rpm", &f.max_speed_rpm, "Table 1.1", "largest speed setpoint accepted");
   b.pos("firmware.overspeed_trip_rpm", &f.overspeed_trip_rpm, "assumed", "over-speed trip", A);
@@ -156,7 +158,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   auto& h = c.estimators.hfi;
   b.pos("estimators.hfi.voltage_V", &h.voltage_V, "Sec. 6.2.2", "HFI carrier amplitude on the estimated d axis");
   b.pos("estimators.hfi.frequency_Hz", &h.frequency_Hz, "Sec. 6.2.2", "HFI carrier frequency");
-  b.pos("estimators.hfi.bandpass_bandwidth_Hz", &h.bandpass_bandwidth_Hz, "Sec. 6.2.2", "HFI band-pass bandwidth");
+  b.pos("estimators.hfi.bandpass_bandwidth_Hz", &h.bandpass_bandwidth_Hz, "assumed",
+        "HFI band-pass bandwidth (thesis Sec. 6.2.2: 25 Hz, whose 13 ms envelope lag destabilised the PLL)", A);
   b.pos("estimators.hfi.pll_bandwidth_Hz", &h.pll_bandwidth_Hz, "assumed", "HFI phase-locked loop bandwidth", A);
   auto& e = c.estimators.eemf;
   b.pos("estimators.eemf.ld_H", &e.ld_H, "Sec. 6.2.3", "EEMF-CONST d inductance");

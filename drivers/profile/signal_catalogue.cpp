@@ -45,6 +45,7 @@ constexpr SignalSpec kSynrm[] = {
     {"pac_W", R::telemetry, false, "W", "the drive's estimate of its output power"},
     {"temp_C", R::telemetry, false, "C", "power-stage temperature"},
     {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
+    {"pos_err_deg", R::telemetry, false, "deg", "estimated minus encoder angle, last control period; not with the encoder"},
     {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
     {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, true, "", "control periods accumulated"},
@@ -66,6 +67,7 @@ constexpr SignalSpec kSynrm[] = {
     {"window_ld_est_H", R::window_result, false, "H", "estimated d inductance, mean; not with the encoder"},
     {"window_lq_est_H", R::window_result, false, "H", "estimated q inductance, mean; not with the encoder"},
     {"window_rs_est_ohm", R::window_result, false, "ohm", "estimated stator resistance, mean; not with the encoder"},
+    {"window_fallback_fraction", R::window_result, false, "", "fraction of samples on the low-speed fallback source, 0..1"},
 };
 
 constexpr SignalSpec kLoad[] = {

@@ -20,6 +20,13 @@ double wrap_pi(double x) {
   return x - kPi;
 }
 
+// A SynRM is symmetric under 180 electrical degrees: a position error in rad as deg in (-90, 90].
+double wrap_half_turn_deg(double err_rad) {
+  double e = std::remainder(err_rad, kPi) * 180.0 / kPi;
+  if (e <= -90.0) e += 180.0;
+  return e;
+}
+
 }  // namespace
 
 SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
@@ -85,7 +92,8 @@ std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
 std::error_code SynrmDriveFirmware::set_angle_deg(double angle_deg) {
   if (!std::isfinite(angle_deg) || angle_deg <= 0.0 || angle_deg >= 90.0)
     return make_error_code(errc::invalid_argument);
-  angle_rad_ = angle_deg * kPi / 180.0;
+  angle_set_rad_ = angle_deg * kPi / 180.0;
+  if (state_ != drivers::DriveState::running) angle_rad_ = angle_set_rad_;
   return {};
 }
 
@@ -202,6 +210,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   DriveOutput out;
   out.pwm = pwm_;
   limited_ = false;
+  double u_est_alpha = 0, u_est_beta = 0;  // the estimators' view of the applied voltage
   if (state_ == drivers::DriveState::stopping && std::fabs(speed_rpm) < kStoppedRpm &&
       std::fabs(speed_ref_rpm_) < kStoppedRpm)
     trip(pending_fault_);
@@ -213,6 +222,15 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       speed_ref_rpm_ += std::clamp(speed_set_rpm_ - speed_ref_rpm_, -max_step, max_step);
       im_req_A_ = speed_pi_.update((speed_ref_rpm_ - speed_ctrl_rpm) / kRpmPerRadS, dt);
     }
+    // Sensorless, the current angle moves at a limited rate [assumed]: a step of the current
+    // vector's direction at full current (76 to 40 deg between chained sweep points) is the
+    // largest disturbance an observer sees, and HFI lost its lock on it. With the encoder the
+    // angle steps as commanded.
+    const double slew_rad = cfg_.firmware.sensorless_angle_slew_deg_per_s * kPi / 180.0 * ts_;
+    if (estimator_ && slew_rad > 0)
+      angle_rad_ += std::clamp(angle_set_rad_ - angle_rad_, -slew_rad, slew_rad);
+    else
+      angle_rad_ = angle_set_rad_;
     // Motoring and braking both keep i_d positive; the sign of I_m goes to i_q (torque sign).
     const double id_ref = std::fabs(im_req_A_) * std::cos(angle_rad_);
     const double iq_ref = im_req_A_ * std::sin(angle_rad_);
@@ -237,6 +255,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     const double th_out = theta_e + 1.5 * we * ts_;
     const double co = std::cos(th_out), so = std::sin(th_out);
     double ualpha = co * ud - so * uq, ubeta = so * ud + co * uq;
+    double comp_alpha = 0, comp_beta = 0;
     if (dead_time_V_per_V_ > 0) {
       // Compensate the dead-time error with the direction of the reference phase currents.
       const Phases iref = to_phases(co * id_ref - so * iq_ref, so * id_ref + co * iq_ref);
@@ -244,10 +263,9 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       for (int n = 0; n < 3; ++n)
         comp[n] = dead_time_V_per_V_ * s.udc_V *
                   std::clamp(iref[n] / cfg_.inverter.dead_time_current_band_A, -1.0, 1.0);
-      double ca2, cb2;
-      to_alpha_beta(comp, ca2, cb2);
-      ualpha += ca2;
-      ubeta += cb2;
+      to_alpha_beta(comp, comp_alpha, comp_beta);
+      ualpha += comp_alpha;
+      ubeta += comp_beta;
     }
     const double mag = std::hypot(ualpha, ubeta);
     if (mag > u_max) {
@@ -259,12 +277,18 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     out.gates_on = true;
     out.ualpha_V = ualpha;
     out.ubeta_V = ubeta;
+    // What the estimators take as the applied voltage: the command without the dead-time
+    // compensation, which only cancels the inverter's dead-time error (the phase voltage
+    // the inverter is believed to produce). Feeding them the compensated command would
+    // add the full dead-time voltage, U_dc t_d / T_pwm, to their voltage balance.
+    u_est_alpha = ualpha - (limited_ ? comp_alpha * u_max / mag : comp_alpha);
+    u_est_beta = ubeta - (limited_ ? comp_beta * u_max / mag : comp_beta);
     out.duty = InverterModel::duties(ualpha, ubeta, s.udc_V);
   }
   u_hist_[1][0] = u_hist_[0][0];
   u_hist_[1][1] = u_hist_[0][1];
-  u_hist_[0][0] = out.ualpha_V;
-  u_hist_[0][1] = out.ubeta_V;
+  u_hist_[0][0] = u_est_alpha;
+  u_hist_[0][1] = u_est_beta;
 
   const double im = std::hypot(id_meas_, iq_meas_);
   f_speed_.update(speed_rpm);
@@ -276,6 +300,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   f_udc_.update(s.udc_V);
   f_pac_.update(1.5 * (ud_ref_ * id_meas_ + uq_ref_ * iq_meas_));
   f_temp_.update(s.temp_C);
+  if (estimator_) pos_err_deg_ = wrap_half_turn_deg(theta_e - theta_enc);
   accumulate(s, im, id_meas_, iq_meas_, limited_, theta_e - theta_enc, speed_ctrl_rpm - speed_rpm);
   return out;
 }
@@ -284,6 +309,7 @@ void SynrmDriveFirmware::begin_window(std::int64_t steps) {
   window_len_ = window_left_ = steps;
   window_count_start_ = -1;
   window_limited_ = 0;
+  window_fallback_ = 0;
   window_fault_ = state_ == drivers::DriveState::faulted ? fault_ : drivers::Fault::none;
   for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_, &w_pos_err_,
                          &w_speed_err_, &w_ld_, &w_lq_, &w_rs_, &w_id_enc_, &w_iq_enc_})
@@ -308,9 +334,8 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     const double c = std::cos(pos_err_rad), sn = std::sin(pos_err_rad);
     w_id_enc_.add(c * id - sn * iq);
     w_iq_enc_.add(sn * id + c * iq);
-    double e = std::remainder(pos_err_rad, kPi) * 180.0 / kPi;
-    if (e <= -90.0) e += 180.0;
-    w_pos_err_.add(e);
+    w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
+    window_fallback_ += estimator_->on_fallback() ? 1 : 0;
     w_speed_err_.add(speed_err_rpm);
     const EstimatorOutput o = estimator_->output();
     if (o.ld_H) w_ld_.add(*o.ld_H);
@@ -333,6 +358,7 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   r.udc_V = w_udc_.mean();
   r.temp_C = w_temp_.mean();
   r.voltage_limited_fraction = static_cast<double>(window_limited_) / static_cast<double>(r.samples);
+  r.fallback_fraction = static_cast<double>(window_fallback_) / static_cast<double>(r.samples);
   r.fault = state_ == drivers::DriveState::faulted ? fault_ : window_fault_;
   if (estimator_) {
     r.pos_err_min_deg = w_pos_err_.min();
@@ -364,6 +390,7 @@ drivers::SynrmTelemetry SynrmDriveFirmware::telemetry() const {
   t.pac_W = f_pac_.value();
   t.temp_C = f_temp_.value();
   t.voltage_limited = limited_hold_s_ > 0;
+  if (estimator_) t.pos_err_deg = pos_err_deg_;
   t.state = state_;
   t.fault = fault_;
   return t;

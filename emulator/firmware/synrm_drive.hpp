@@ -88,14 +88,15 @@ class SynrmDriveFirmware {
   drivers::Fault fault_ = drivers::Fault::none;
   drivers::Fault pending_fault_ = drivers::Fault::none;  // latched when the ordered stop ends
   drivers::Pwm pwm_;
-  double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0;
+  double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0, angle_set_rad_ = 0.0;
   std::uint64_t step_ = 0;
 
   // Position source: the selected estimator, or the encoder when null.
   drivers::Estimator estimator_kind_ = drivers::Estimator::encoder;
   std::unique_ptr<Estimator> estimator_;
   bool needs_mcidc_ = false;
-  // Voltages commanded one and two periods ago: the older one acted during the last period.
+  // Voltages commanded one and two periods ago, without the dead-time compensation: the older
+  // one acted during the last period.
   double u_hist_[2][2] = {{0, 0}, {0, 0}};
 
   // Encoder speed observer (tracking PLL on the mechanical angle).
@@ -114,6 +115,8 @@ class SynrmDriveFirmware {
   std::int64_t window_left_ = 0, window_len_ = 0;
   std::int64_t window_count_start_ = 0;
   long window_limited_ = 0;
+  long window_fallback_ = 0;  // samples on the estimator's low-speed fallback
+  double pos_err_deg_ = 0;    // estimated minus encoder angle, last period, (-90, 90] deg
   drivers::Fault window_fault_ = drivers::Fault::none;
   WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;
   WindowStats w_pos_err_, w_speed_err_, w_ld_, w_lq_, w_rs_, w_id_enc_, w_iq_enc_;

@@ -70,6 +70,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
     if (n == "window_ld_est_H") return or0(w.ld_est_H);
     if (n == "window_lq_est_H") return or0(w.lq_est_H);
     if (n == "window_rs_est_ohm") return or0(w.rs_est_ohm);
+    if (n == "window_fallback_fraction") return w.fallback_fraction;
     return 0;
   }
   const drivers::SynrmTelemetry t = fw.telemetry();
@@ -85,6 +86,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
   if (n == "pac_W") return t.pac_W;
   if (n == "temp_C") return t.temp_C;
   if (n == "voltage_limited") return t.voltage_limited ? 1 : 0;
+  if (n == "pos_err_deg") return or0(t.pos_err_deg);
   return 0;
 }
 

@@ -450,18 +450,21 @@ TEST(SweepPresets, ThesisGrid) {
   for (const auto& pt : pts) ++per_config[{pt.request.estimator, pt.request.pwm}];
   EXPECT_EQ(per_config[(Configuration{Estimator::encoder, Pwm::capwm})], 5u * 7u * 19u);  // 665
   EXPECT_EQ(per_config[(Configuration{Estimator::ekf_basic, Pwm::aspwm})], 665u);
-  EXPECT_EQ(per_config[(Configuration{Estimator::hfi, Pwm::capwm})], 665u);
+  EXPECT_EQ(per_config[(Configuration{Estimator::hfi, Pwm::capwm})], 2u * 7u * 19u);  // <= 300 rpm
   EXPECT_EQ(per_config[(Configuration{Estimator::eemf_const, Pwm::capwm})], 3u * 7u * 19u);  // >= 500 rpm
   EXPECT_EQ(per_config[(Configuration{Estimator::eemf_rls, Pwm::capwm})], 399u);
-  EXPECT_EQ(pts.size(), 5u * 665u + 3u * 399u);
+  EXPECT_EQ(pts.size(), 4u * 665u + 266u + 3u * 399u);
   for (const auto& pt : pts) {
     const bool eemf = pt.request.estimator == Estimator::eemf_const || pt.request.estimator == Estimator::eemf_lut ||
                       pt.request.estimator == Estimator::eemf_rls;
     if (eemf) {
       EXPECT_GE(pt.request.speed_rpm, 500.0);
     }
+    if (pt.request.estimator == Estimator::hfi) {
+      EXPECT_LE(pt.request.speed_rpm, 300.0);
+    }
   }
-  EXPECT_EQ(plan_groups(p).size(), 5u * 35u + 3u * 21u);
+  EXPECT_EQ(plan_groups(p).size(), 4u * 35u + 14u + 3u * 21u);
 }
 
 TEST(SweepPresets, ThesisGridWith23AnglesGives805PerConfiguration) {
@@ -534,7 +537,7 @@ TEST(SweepPlanEstimate, TimeModelByHand) {
   EXPECT_NEAR(f.bench_time_s, 8 * 3.5 + 7 * 10.0 + 0.6 + 0.6, 1e-9);
   const auto a = estimate(parse_ok(json::parse(R"({"preset": "thesis-grid", "mode": "adaptive"})")));
   EXPECT_TRUE(a.upper_bound);
-  EXPECT_EQ(a.points, (5u * 35u + 3u * 21u) * 7u);
+  EXPECT_EQ(a.points, (4u * 35u + 14u + 3u * 21u) * 7u);
   EXPECT_EQ(to_json(a)["points"], a.points);
 }
 

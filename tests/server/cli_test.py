@@ -11,7 +11,7 @@ BIN = sys.argv[1]
 RECORD_FIELDS = """speed_rpm load_Nm angle_deg estimator pwm speed_meas_rpm im_A id_A iq_A ud_V uq_V
 udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W efficiency pos_err_min_deg pos_err_mean_deg pos_err_max_deg
 speed_err_rpm ld_est_H lq_est_H rs_est_ohm ld_err_pct lq_err_pct rs_err_pct temp_C window_s samples
-settle_s voltage_limited unstable fault truth""".split()
+settle_s voltage_limited unstable fault below_min_speed fallback_fraction truth""".split()
 TRUTH_FIELDS = "pin_W pcu_W pfe_W pmech_W pinvm_W pm_W temp_C".split()
 failures = []
 
@@ -87,6 +87,20 @@ with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
 code, out, err = run("point", "--speed-rpm", "1200", "--load-Nm", "1", "--angle-deg", "50", "--config", f.name)
 check(code == 2 and "--speed-rpm" in err and "1000" in err, "the configured maximum speed applies")
 os.unlink(f.name)
+
+# Below an EEMF observer's minimum speed (500 rpm) the drive runs on its fallback: the point is
+# measured and flagged; above it the observer gives the angle.
+for speed, below in (("300", True), ("700", False)):
+    code, out, err = run("point", "--speed-rpm", speed, "--load-Nm", "1.5", "--angle-deg", "50",
+                         "--estimator", "eemf-lut", "--json")
+    rec = json.loads(out) if code in (0, 3) and out else {}
+    check(code == 0 and rec.get("below_min_speed") is below,
+          f"eemf-lut at {speed} rpm: below_min_speed {below} ({err.strip()[:200]})")
+    check((rec.get("fallback_fraction", -1) > 0.99) if below else (rec.get("fallback_fraction", -1) == 0),
+          f"eemf-lut at {speed} rpm: fallback_fraction {rec.get('fallback_fraction')}")
+code, out, _ = run("point", "--speed-rpm", "300", "--load-Nm", "1.5", "--angle-deg", "50", "--json")
+check(code == 0 and json.loads(out)["below_min_speed"] is False and json.loads(out)["fallback_fraction"] == 0,
+      "encoder at 300 rpm: not flagged")
 
 print(f"{(len(failures) == 0) and 'all' or len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
 sys.exit(1 if failures else 0)

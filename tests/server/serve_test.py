@@ -159,8 +159,8 @@ def main():
         s, data, _ = d.request("GET", "/api/presets", token=viewer)
         presets = {p["name"]: p for p in json.loads(data)}
         check(s == 200 and set(presets) == {"thesis-grid", "iec-61800-9-2"}, "presets listed")
-        check(presets["thesis-grid"]["estimate"]["points"] == 5 * 7 * 19 * 8 - 2 * 3 * 7 * 19,
-              "thesis grid: 5 x 7 x 19 points per configuration, EEMF variants from 500 rpm (%s)"
+        check(presets["thesis-grid"]["estimate"]["points"] == 5 * 7 * 19 * 8 - 2 * 3 * 7 * 19 - 3 * 7 * 19,
+              "thesis grid: 5 x 7 x 19 points per configuration, EEMF variants from 500 rpm, HFI to 300 rpm (%s)"
               % presets["thesis-grid"]["estimate"]["points"])
         s, data, _ = d.request("POST", "/api/sweeps/estimate", token=viewer,
                                body={"dimensions": {"speed_rpm": [300, 600], "load_Nm": [1, 2], "angle_deg": {"from": 44, "to": 64, "step": 10}}})
@@ -304,6 +304,7 @@ def main():
         check(abs(speed - 400) < 20, "twin speed follows the setpoint (%.1f rpm)" % speed)
         s, data, _ = d.request("POST", "/api/bench/mode", body={"pwm": "aspwm"}, token=op)
         check(s == 409 and error_of(data)[0] == "bench_enabled", "mode change refused while enabled")
+        check(st["synrm"]["pos_err_deg"] is None, "no live position error with the encoder")
         s, data, _ = d.request("GET", "/metrics")
         check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
         check("synbench_ws_clients 0" in data.decode() and "synbench_ws_dropped_total 0" in data.decode(),
@@ -331,6 +332,22 @@ def main():
         s, _, _ = d.request("DELETE", "/api/bench/lock", token=op)
         check(s == 200, "op releases the lock")
 
+        # Sensorless: the live telemetry carries the estimator's position error.
+        # (EKF-BASIC with ASPWM, the thesis configuration.)
+        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "ekf-basic", "pwm": "aspwm"}, token=op)
+        check(s == 200, "mode ekf-basic (%s)" % data[:200])
+        d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 500, "load_Nm": 1.0, "angle_deg": 50}, token=op)
+        d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        errs = []
+        deadline = time.time() + 15
+        while time.time() < deadline and len(errs) < 5:
+            _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+            st = json.loads(data)
+            if st["synrm"] and abs(st["synrm"]["speed_rpm"] - 500) < 25:
+                errs.append(st["synrm"]["pos_err_deg"])
+            time.sleep(0.2)
+        check(len(errs) == 5 and all(e is not None and abs(e) < 10 for e in errs),
+              "EKF-BASIC at 500 rpm: live position error within 10 deg (%s)" % errs)
         # Run again, then SIGTERM: ordered stop, exit 0.
         d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         time.sleep(1)

@@ -46,17 +46,36 @@ constexpr std::array<int, 3> kIalphaNonzero{EkfRs::kId, EkfRs::kIq, EkfRs::kTh};
 constexpr std::array<int, 3> kIbetaNonzero{EkfRs::kId, EkfRs::kIq, EkfRs::kTh};
 
 // The rows of F that differ from the identity (i_d, i_q, th_e, in that order) and the predicted
-// i_d, i_q, th_e, for u_dq = Park(u_alpha,beta, th_e) with cos/sin(th_e) = c, s.
+// i_d, i_q, th_e, for u_dq = Park(u_alpha,beta, th_e) with cos/sin(th_e) = c, s. Back-EMF flux
+// from the maps when given, else Psi = i / R'.
 void process(const EkfRs::State& x, double c, double s, double ualpha, double ubeta, double ts,
-             Rows3& rows, double& id_next, double& iq_next, double& th_next) {
+             const EkfRs::FluxMaps* maps, Rows3& rows, double& id_next, double& iq_next,
+             double& th_next) {
   using E = EkfRs;
   const double rd = x(E::kRd), rq = x(E::kRq), id = x(E::kId), iq = x(E::kIq);
   const double w = x(E::kW), rs = x(E::kRs);
   const double ud = c * ualpha + s * ubeta;
   const double uq = -s * ualpha + c * ubeta;
   const double inv_rd = 1.0 / rd, inv_rq = 1.0 / rq;
-  const double dd = ud - rs * id + w * iq * inv_rq;  // R'd^-1 di_d/dt
-  const double dq = uq - rs * iq - w * id * inv_rd;  // R'q^-1 di_q/dt
+  // Psi_d, Psi_q and their derivatives with respect to i_d, i_q and R'd, R'q.
+  double psi_d, psi_q, dpsid_did, dpsiq_diq, dpsid_drd, dpsiq_drq;
+  if (maps) {
+    psi_d = maps->d.psi(id);
+    psi_q = maps->q.psi(iq);
+    dpsid_did = maps->d.dynamic_inductance_H(id);
+    dpsiq_diq = maps->q.dynamic_inductance_H(iq);
+    dpsid_drd = dpsiq_drq = 0.0;
+  } else {
+    psi_d = id * inv_rd;
+    psi_q = iq * inv_rq;
+    dpsid_did = inv_rd;
+    dpsiq_diq = inv_rq;
+    dpsid_drd = -psi_d * inv_rd;
+    dpsiq_drq = -psi_q * inv_rq;
+  }
+  // (The linear model keeps the thesis' w i / R' evaluation order.)
+  const double dd = ud - rs * id + (maps ? w * psi_q : w * iq * inv_rq);  // R'd^-1 di_d/dt
+  const double dq = uq - rs * iq - (maps ? w * psi_d : w * id * inv_rd);  // R'q^-1 di_q/dt
   const double ts_rd = ts * rd, ts_rq = ts * rq;
 
   id_next = id + ts_rd * dd;
@@ -65,18 +84,18 @@ void process(const EkfRs::State& x, double c, double s, double ualpha, double ub
 
   rows.setZero();
   rows(0, E::kRd) = ts * dd;
-  rows(0, E::kRq) = -ts_rd * w * iq * inv_rq * inv_rq;
+  rows(0, E::kRq) = ts_rd * w * dpsiq_drq;
   rows(0, E::kId) = 1.0 - ts_rd * rs;
-  rows(0, E::kIq) = ts_rd * w * inv_rq;
-  rows(0, E::kW) = ts_rd * iq * inv_rq;
+  rows(0, E::kIq) = ts_rd * w * dpsiq_diq;
+  rows(0, E::kW) = ts_rd * psi_q;
   rows(0, E::kTh) = ts_rd * uq;
   rows(0, E::kRs) = -ts_rd * id;
 
-  rows(1, E::kRd) = ts_rq * w * id * inv_rd * inv_rd;
+  rows(1, E::kRd) = -ts_rq * w * dpsid_drd;
   rows(1, E::kRq) = ts * dq;
-  rows(1, E::kId) = -ts_rq * w * inv_rd;
+  rows(1, E::kId) = -ts_rq * w * dpsid_did;
   rows(1, E::kIq) = 1.0 - ts_rq * rs;
-  rows(1, E::kW) = -ts_rq * id * inv_rd;
+  rows(1, E::kW) = -ts_rq * psi_d;
   rows(1, E::kTh) = -ts_rq * ud;
   rows(1, E::kRs) = -ts_rq * iq;
 
@@ -87,6 +106,8 @@ void process(const EkfRs::State& x, double c, double s, double ualpha, double ub
 }  // namespace
 
 EkfRs::EkfRs(const EkfRsParams& params) : params_(params) {
+  if (params_.flux_d && params_.flux_q)
+    maps_.emplace(FluxMaps{FluxAxis(*params_.flux_d), FluxAxis(*params_.flux_q)});
   const double vi = (2.0 / 3.0) * params_.sigma_i_A * params_.sigma_i_A;
   const double vrel = params_.sigma_rel_per_H * params_.sigma_rel_per_H;
   q_diag_ << vrel, vrel, vi, vi, params_.sigma_w_rad_s * params_.sigma_w_rad_s,
@@ -111,18 +132,20 @@ void EkfRs::reset(const State& x, const Cov& p) {
   p_ = p;
 }
 
-EkfRs::State EkfRs::f(const State& x, double ualpha_V, double ubeta_V, double ts_s) {
+EkfRs::State EkfRs::f(const State& x, double ualpha_V, double ubeta_V, double ts_s,
+                      const FluxMaps* maps) {
   Rows3 rows;
   State y = x;
-  process(x, std::cos(x(kTh)), std::sin(x(kTh)), ualpha_V, ubeta_V, ts_s, rows, y(kId), y(kIq),
-          y(kTh));
+  process(x, std::cos(x(kTh)), std::sin(x(kTh)), ualpha_V, ubeta_V, ts_s, maps, rows, y(kId),
+          y(kIq), y(kTh));
   return y;
 }
 
-EkfRs::Cov EkfRs::jacobian_f(const State& x, double ualpha_V, double ubeta_V, double ts_s) {
+EkfRs::Cov EkfRs::jacobian_f(const State& x, double ualpha_V, double ubeta_V, double ts_s,
+                             const FluxMaps* maps) {
   Rows3 rows;
   double id, iq, th;
-  process(x, std::cos(x(kTh)), std::sin(x(kTh)), ualpha_V, ubeta_V, ts_s, rows, id, iq, th);
+  process(x, std::cos(x(kTh)), std::sin(x(kTh)), ualpha_V, ubeta_V, ts_s, maps, rows, id, iq, th);
   Cov fm = Cov::Identity();
   fm.row(kId) = rows.row(0);
   fm.row(kIq) = rows.row(1);
@@ -196,7 +219,7 @@ void EkfRs::update(const EstimatorInput& in) {
     const double c = std::cos(x_(kTh)), s = std::sin(x_(kTh));
     Rows3 rows;
     double id, iq, th;
-    process(x_, c, s, in.ualpha_V, in.ubeta_V, ts, rows, id, iq, th);
+    process(x_, c, s, in.ualpha_V, in.ubeta_V, ts, flux_maps(), rows, id, iq, th);
     const bool rs_free = std::abs(x_(kW)) >= params_.rs_speed_threshold_rad_s;
     x_(kId) = id;
     x_(kIq) = iq;
@@ -255,7 +278,10 @@ void EkfRs::update(const EstimatorInput& in) {
   x_(kRq) = std::max(x_(kRq), params_.min_reluctance_per_H);
   x_(kRs) = std::max(x_(kRs), params_.min_rs_ohm);
   if (params_.enforce_ld_above_lq && x_(kRd) > x_(kRq)) {
-    // (R'd, R'q, i_d, i_q, th) -> (R'q, R'd, i_q, -i_d, th + pi/2): same f and h.
+    // (R'd, R'q, i_d, i_q, th) -> (R'q, R'd, i_q, -i_d, th + pi/2): same f and h for the linear
+    // model. With flux maps the axes are no longer interchangeable in f, and the map is a
+    // re-labelling onto the convention the maps assume (it happens during the first
+    // milliseconds from the symmetric x0, before the currents carry information).
     std::swap(x_(kRd), x_(kRq));
     const double id_old = x_(kId);
     x_(kId) = x_(kIq);

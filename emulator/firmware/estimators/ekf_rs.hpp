@@ -3,24 +3,34 @@
 //
 // State x = [R'd, R'q, i_d, i_q, w_e, th_e, Rs], input u_alpha,beta (turned into u_dq by Park
 // with the estimated angle, so the process Jacobian has d/d th_e terms). Process (Euler):
-//   i_d += Ts R'd (u_d - Rs i_d + w_e i_q / R'q),  i_q += Ts R'q (u_q - Rs i_q - w_e i_d / R'd),
+//   i_d += Ts R'd (u_d - Rs i_d + w_e Psi_q),  i_q += Ts R'q (u_q - Rs i_q - w_e Psi_d),
 //   th_e += Ts w_e, the rest constant.
+// The flux in the rotational (back-EMF) terms is, as in the thesis, Psi = i / R' (linear machine)
+// unless the drive's flux maps are given: then Psi_d(i_d), Psi_q(i_q) from the maps (apparent
+// inductances), while the reluctances R' = 1/L' (incremental, what the MCIDC measures) stay on
+// di/dt. On a saturated machine the linear model's back-EMF is wrong by w (Psi - L' i), volts
+// that Rs absorbs (up to 320 % at 3.5 N m); with the maps Rs is the only unknown left in the
+// voltage balance (docs/estimators.md).
 // Measurements y = [R'_phN, i_alpha, i_beta] with the MCIDC sample, [i_alpha, i_beta] without.
 // Rs gets process noise only while |w_e| is above a speed threshold (thesis Fig. 5.21). The model
 // is invariant under (th_e + pi, -i_d, -i_q), so the filter may lock at th_e + pi (valid for a
 // SynRM). It is also exactly invariant under (R'd <-> R'q, i_d -> i_q, i_q -> -i_d,
 // th_e + pi/2): from the symmetric thesis x0 the filter can lock with the axes swapped. With
 // enforce_ld_above_lq (default) the filter keeps to the convention Ld > Lq (physics.md 0) by
-// applying that symmetry to the state and covariance whenever R'd > R'q; this is an exact change
-// of coordinates, not a correction.
+// applying that symmetry to the state and covariance whenever R'd > R'q; for the linear model
+// this is an exact change of coordinates, not a correction (with the flux maps, a re-labelling
+// onto the axes the maps assume).
 #pragma once
 
 #include <array>
 #include <numbers>
+#include <optional>
 
 #include <Eigen/Core>
 
 #include "emulator/firmware/estimators/estimator.hpp"
+#include "emulator/flux_map.hpp"
+#include "emulator/twin_config.hpp"
 
 namespace synbench::emulator::firmware {
 
@@ -38,6 +48,8 @@ struct EkfRsParams {
   double min_reluctance_per_H = 0.05;  // floor on R'd, R'q (keeps L = 1/R' finite)
   double min_rs_ohm = 0.0;             // floor on Rs
   bool enforce_ld_above_lq = true;     // keep the d axis on the larger inductance
+  // The drive's flux maps for the back-EMF terms; both unset = the thesis' linear model.
+  std::optional<FluxAxisParams> flux_d, flux_q;
   std::array<double, 7> x0{2.0, 2.0, 0.0, 0.0, 0.0, 0.0, 5.0};
   std::array<double, 7> p0_diag{0.01, 0.01, 1.0, 1.0, 100.0, 1.0, 0.01};
 };
@@ -69,10 +81,18 @@ class EkfRs final : public Estimator {
   const Cov& covariance() const { return p_; }
   const EkfRsParams& params() const { return params_; }
 
+  // Flux of the back-EMF terms: the maps, or null for Psi = i / R'.
+  struct FluxMaps {
+    FluxAxis d, q;
+  };
+
   // The model, public so tests can check the Jacobians against finite differences.
   // u_alpha, u_beta are stationary-frame voltages; Park uses x's th_e.
-  static State f(const State& x, double ualpha_V, double ubeta_V, double ts_s);
-  static Cov jacobian_f(const State& x, double ualpha_V, double ubeta_V, double ts_s);
+  static State f(const State& x, double ualpha_V, double ubeta_V, double ts_s,
+                 const FluxMaps* maps = nullptr);
+  static Cov jacobian_f(const State& x, double ualpha_V, double ubeta_V, double ts_s,
+                        const FluxMaps* maps = nullptr);
+  const FluxMaps* flux_maps() const { return maps_ ? &*maps_ : nullptr; }
   static Meas3 h(const State& x, int phase);
   static Jac3 jacobian_h(const State& x, int phase);
   static Meas2 h_currents(const State& x);
@@ -86,6 +106,7 @@ class EkfRs final : public Estimator {
                const std::array<std::array<int, 3>, M>& nonzero);
 
   EkfRsParams params_;
+  std::optional<FluxMaps> maps_;
   State x_;
   Cov p_;
   State q_diag_;       // with sigma_Rs

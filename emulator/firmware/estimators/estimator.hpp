@@ -39,6 +39,9 @@ class Estimator {
   // The currents, in the estimated frame, the current controllers should regulate: an injecting
   // estimator removes its own high-frequency response. Unchanged by default.
   virtual void fundamental(double& /*id_A*/, double& /*iq_A*/) const {}
+  // True while a low-speed fallback, not this estimator, gives the angle (LowSpeedHandover below
+  // its minimum speed): the measurement window counts those samples.
+  virtual bool on_fallback() const { return false; }
   // Takes over the given angle and speed (a handover from another position source).
   virtual void align(double /*theta_e_rad*/, double /*omega_e_rad_s*/) {}
 };

@@ -13,6 +13,16 @@ namespace {
 
 constexpr double kRadSPerRpm = 2.0 * 3.14159265358979323846 / 60.0;
 
+ShaftStiffnessParams stiffness(const TwinConfig& config) {
+  ShaftStiffnessParams s;
+  s.flux_d = config.synrm.flux_d;
+  s.flux_q = config.synrm.flux_q;
+  s.pole_pairs = config.synrm.pole_pairs;
+  // The drive tunes its speed loop with the same inertia.
+  s.inertia_kgm2 = config.total_inertia_kgm2();
+  return s;
+}
+
 std::unique_ptr<Estimator> make_hfi(const TwinConfig& config) {
   const auto& h = config.estimators.hfi;
   HfiParams p;
@@ -21,6 +31,7 @@ std::unique_ptr<Estimator> make_hfi(const TwinConfig& config) {
   p.frequency_Hz = h.frequency_Hz;
   p.bandpass_bandwidth_Hz = h.bandpass_bandwidth_Hz;
   p.pll_bandwidth_Hz = h.pll_bandwidth_Hz;
+  p.stiffness = stiffness(config);
   return std::make_unique<Hfi>(p);
 }
 
@@ -70,6 +81,10 @@ EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config
       EkfRsParams p;
       p.ts_s = ts;
       p.rs_speed_threshold_rad_s = rs_threshold;
+      // The drive's flux maps (those of its decoupling and of EEMF-LUT) for the back-EMF terms:
+      // with the thesis' linear model Rs absorbs the saturated machine's back-EMF error.
+      p.flux_d = config.synrm.flux_d;
+      p.flux_q = config.synrm.flux_q;
       c.estimator = std::make_unique<EkfRs>(p);
       c.needs_mcidc = true;
       return c;

@@ -20,6 +20,7 @@ class LowSpeedHandover final : public Estimator {
   void injection(double& ud_V, double& uq_V) const override;
   void fundamental(double& id_A, double& iq_A) const override;
   bool main_active() const { return main_active_; }
+  bool on_fallback() const override { return !main_active_; }
 
  private:
   std::unique_ptr<Estimator> main_, fallback_;

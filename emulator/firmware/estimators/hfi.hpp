@@ -2,10 +2,12 @@
 // carrier on the estimated d axis; the q-axis current response, band-passed and demodulated
 // (heterodyne), is proportional to (1/Lq - 1/Ld) sin(2 th_err); a PI phase-locked loop drives it
 // to zero and yields speed and angle. The HF components are removed from the currents the
-// current controllers see. The 180 deg ambiguity is harmless for a SynRM.
+// current controllers see. The 180 deg ambiguity is harmless for a SynRM. Where the shaft makes an
+// angle error grow (above the MTPA angle, shaft_stiffness.hpp) the PLL's bandwidth is raised.
 #pragma once
 
 #include "emulator/firmware/estimators/estimator.hpp"
+#include "emulator/firmware/estimators/shaft_stiffness.hpp"
 #include "emulator/firmware/estimators/tracking_observer.hpp"
 #include "emulator/firmware/pi.hpp"
 
@@ -15,13 +17,17 @@ struct HfiParams {
   double ts_s = 1e-4;
   double voltage_V = 20.0;            // carrier amplitude (Sec. 6.2.2)
   double frequency_Hz = 500.0;        // carrier frequency (Sec. 6.2.2)
-  double bandpass_bandwidth_Hz = 25.0;
+  // [assumed] thesis 25 Hz: that band-pass's 13 ms envelope lag sat inside the PLL.
+  double bandpass_bandwidth_Hz = 200.0;
   double demod_lowpass_s = 2e-3;      // [assumed] removes the 2 f_hf product of the heterodyne
   double pll_bandwidth_Hz = 10.0;     // [assumed]
   // Incremental inductances that scale the demodulated error to radians [assumed: typical
   // operating values]; a wrong value only changes the PLL's loop gain.
   double ld_hf_H = 0.5;
   double lq_hf_H = 0.12;
+  // Raises the PLL bandwidth where the shaft makes an angle error grow (inertia 0: off).
+  ShaftStiffnessParams stiffness;
+  double stiffness_current_filter_s = 0.02;  // [assumed] smoothing of the currents it takes
 };
 
 class Hfi final : public Estimator {
@@ -40,6 +46,9 @@ class Hfi final : public Estimator {
   BandPass bp_d_, bp_q_;
   LowPass demod_;
   TrackingObserver pll_;
+  ShaftStiffness stiffness_;
+  LowPass id_f_, iq_f_;
+  double wn_own_ = 0;
 };
 
 }  // namespace synbench::emulator::firmware

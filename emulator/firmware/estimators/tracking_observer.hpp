@@ -9,9 +9,12 @@ namespace synbench::emulator::firmware {
 class TrackingObserver {
  public:
   void configure(double bandwidth_Hz) {
-    const double wn = 2.0 * 3.14159265358979323846 * bandwidth_Hz;
-    kp_ = 2.0 * wn;
-    ki_ = wn * wn;
+    set_natural_frequency(2.0 * 3.14159265358979323846 * bandwidth_Hz);
+  }
+  // Critically damped at wn; an observer may retune it while running (HFI, shaft_stiffness.hpp).
+  void set_natural_frequency(double wn_rad_s) {
+    kp_ = 2.0 * wn_rad_s;
+    ki_ = wn_rad_s * wn_rad_s;
   }
   void reset(double theta_rad, double omega_rad_s) {
     theta_ = theta_rad;
