@@ -39,16 +39,6 @@ std::variant<nlohmann::json, Response> parse_json_object(const std::string& body
 
 namespace {
 
-const char* phase_name(bench::SafetyPhase p) {
-  switch (p) {
-    case bench::SafetyPhase::normal: return "normal";
-    case bench::SafetyPhase::stopping_load: return "stopping_load";
-    case bench::SafetyPhase::stopping_speed: return "stopping_speed";
-    case bench::SafetyPhase::stopped: return "stopped";
-    case bench::SafetyPhase::estopped: return "estopped";
-  }
-  return "?";
-}
 
 const char* state_name(drivers::DriveState s) {
   switch (s) {
@@ -105,6 +95,17 @@ Response locked(const ControlLock& lock) {
                         "the control lock is held by " + d.value("holder", std::string("another operator")) +
                             " (it expires after " + std::to_string(ControlLock::kIdle.count()) +
                             " s idle; E-stop is always allowed)");
+}
+
+const char* phase_name(bench::SafetyPhase p) {
+  switch (p) {
+    case bench::SafetyPhase::normal: return "normal";
+    case bench::SafetyPhase::stopping_load: return "stopping_load";
+    case bench::SafetyPhase::stopping_speed: return "stopping_speed";
+    case bench::SafetyPhase::stopped: return "stopped";
+    case bench::SafetyPhase::estopped: return "estopped";
+  }
+  return "?";
 }
 
 nlohmann::json status_json(const BenchStatus& s) {

@@ -103,6 +103,8 @@ void add_api_routes(Router& router, ApiContext ctx);
 std::variant<nlohmann::json, Response> parse_json_object(const std::string& body);
 
 nlohmann::json status_json(const BenchStatus& s);
+// The supervisor's phase as the API names it: "normal", "stopping_load", ... "estopped".
+const char* phase_name(bench::SafetyPhase p);
 std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
                             const std::optional<WsCounts>& ws = std::nullopt);
 

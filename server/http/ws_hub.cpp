@@ -10,17 +10,6 @@ namespace synbench::http {
 
 namespace {
 
-const char* phase_name(bench::SafetyPhase p) {
-  switch (p) {
-    case bench::SafetyPhase::normal: return "normal";
-    case bench::SafetyPhase::stopping_load: return "stopping_load";
-    case bench::SafetyPhase::stopping_speed: return "stopping_speed";
-    case bench::SafetyPhase::stopped: return "stopped";
-    case bench::SafetyPhase::estopped: return "estopped";
-  }
-  return "?";
-}
-
 SharedText share(std::string s) { return std::make_shared<const std::string>(std::move(s)); }
 
 }  // namespace
