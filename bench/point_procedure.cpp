@@ -1,6 +1,7 @@
 // The operating-point state machine and its runner.
 #include "bench/point_procedure.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "drivers/error.hpp"
@@ -105,8 +106,24 @@ void PointProcedure::tick(double now_s) {
     }
     case PointPhase::settle: {
       gate_.add(now_s, st.speed_rpm, st.im_A, st.pac_W);
-      const bool settled = now_s - t_phase_ >= opt_.min_settle_s && gate_.steady();
+      const double lost_band = std::max(opt_.speed_lost_band_rel * std::fabs(req_.speed_rpm),
+                                        opt_.speed_lost_band_min_rpm);
+      if (std::fabs(st.speed_rpm - req_.speed_rpm) <= lost_band)
+        t_off_speed_ = -1;
+      else if (t_off_speed_ < 0)
+        t_off_speed_ = now_s;
+      speed_lost_ = t_off_speed_ >= 0 && now_s - t_off_speed_ >= opt_.speed_lost_s;
+      // Steady far off the setpoint (a stalled shaft) is not settled.
+      const bool settled = now_s - t_phase_ >= opt_.min_settle_s && gate_.steady() && t_off_speed_ < 0;
       const bool timed_out = now_s - t_phase_ > opt_.settle_timeout_s;
+      if (speed_lost_) {
+        record_.unstable = true;
+        if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
+        t_window_ = now_s;
+        record_.settle_s = now_s - t_start_;
+        enter(PointPhase::measure, now_s);
+        return;
+      }
       if (settled || timed_out) {
         if (timed_out && !settled) record_.unstable = true;
         if (opt_.thermal && std::fabs(st.temp_C - opt_.thermal->target_C) > opt_.thermal->band_C) {

@@ -37,6 +37,14 @@ struct PointOptions {
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
   // new setpoints are commanded together and the gate decides when the bench has settled.
   bool continue_running = false;
+  // A drive that cannot hold the commanded speed while settling (a sensorless observer that lost
+  // the rotor: the shaft stalls while the estimate spins on) is measured at once, flagged
+  // unstable and reported by speed_lost(), instead of waiting out the gate's timeout (a sweep
+  // then restarts the drives for its next point). Off the speed by more than
+  // max(rel x |setpoint|, min) for `speed_lost_s`.
+  double speed_lost_band_rel = 0.2;
+  double speed_lost_band_min_rpm = 50.0;
+  double speed_lost_s = 1.0;
   SteadyStateBands gate;
   // Thermal precondition (Sec. 6.3.2): measure only within target +/- band; a cold machine is
   // warmed with `warmup_load_Nm`, a hot one cooled unloaded; after `timeout_s` the point is
@@ -61,6 +69,8 @@ class PointProcedure {
   const PointRecord& record() const { return record_; }
   // Why the procedure failed: which device call and what it said.
   const std::string& error() const { return error_; }
+  // The drive could not hold the commanded speed while settling (see PointOptions).
+  bool speed_lost() const { return speed_lost_; }
 
  private:
   bool check(std::error_code ec, const char* what);
@@ -73,8 +83,8 @@ class PointProcedure {
   PointOptions opt_;
   SteadyStateGate gate_;
   PointPhase phase_ = PointPhase::start;
-  double t_start_ = 0, t_phase_ = 0, t_window_ = 0, t_thermal_ = -1;
-  bool has_record_ = false;
+  double t_start_ = 0, t_phase_ = 0, t_window_ = 0, t_thermal_ = -1, t_off_speed_ = -1;
+  bool has_record_ = false, speed_lost_ = false;
   PointRecord record_;
   std::string error_;
 };

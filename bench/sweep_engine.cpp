@@ -1,7 +1,9 @@
 // The sweep engine's state machine.
 #include "bench/sweep_engine.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace synbench::bench {
 namespace {
@@ -127,6 +129,17 @@ void SweepEngine::finish_point(double /*now_s*/) {
   if (n.search) searches_[*n.search].report(r.angle_deg, r.im_A, r.pdcm_W);
   if (plan_.mode == SweepMode::grid) ++grid_pos_;
   sink_.progress(progress());
+  if (proc->speed_lost()) {
+    // The drive lost the speed (a sensorless observer that slipped off the rotor does not find
+    // it again while the shaft stalls): ordered stop, and the next point starts from standstill.
+    char what[160];
+    std::snprintf(what, sizeof what,
+                  "point %zu: the drive could not hold %.0f rpm (measured %.0f rpm); restarting "
+                  "the drives for the next point",
+                  static_cast<std::size_t>(n.point.index), r.speed_rpm, r.speed_meas_rpm);
+    sink_.event("log", what);
+    begin_stop(SweepState::running, now_);
+  }
 }
 
 void SweepEngine::begin_stop(SweepState final_state, double now_s) {

@@ -1,7 +1,8 @@
 // Phase-reluctance measurement from the DC-link current slope (MCIDC, physics.md 6, thesis 5.1).
 // The slope sees the dynamic inductances at the operating point; the sample carries white noise,
 // a gain error and a periodic deformation. ASPWM measures one phase per period (a, b, c in turn);
-// CAPWM measures the phase with the longer active vector, and nothing when it is too short.
+// CAPWM measures the phase with the longer active vector, and nothing when it is too short; with
+// the modulator's window shift (an MCIDC estimator selected) it too measures a, b, c in turn.
 #pragma once
 
 #include <cmath>
@@ -34,9 +35,15 @@ class Mcidc {
 
   std::optional<McidcSample> measure(std::uint64_t step, drivers::Pwm pwm, const Phases& duty,
                                      double theta_e, double ld_dyn_H, double lq_dyn_H,
-                                     Noise& noise) const {
+                                     Noise& noise, bool window_shift = false) const {
     int phase;
-    if (pwm == drivers::Pwm::aspwm) {
+    if (pwm == drivers::Pwm::aspwm || window_shift) {
+      // ASPWM, or CAPWM with the window shift: one phase per period, a, b, c in turn. The
+      // natural CAPWM choice (the phase with the longer active vector) follows the voltage
+      // vector, which at speed lies near the q axis, where R'_ph barely depends on the angle:
+      // fed those samples EKF-BASIC lost lock at 500 rpm. Shifting the chosen leg's pulse
+      // by the minimum active time against the other two (same duty, same edges) opens a
+      // window in which only that leg differs, whatever the duties.
       phase = static_cast<int>(step % 3);
     } else {
       int hi = 0, lo = 0;

@@ -134,7 +134,8 @@ void Twin::step() {
   if (synrm_fw_.needs_mcidc() && gates) {
     mcidc_sample_ = mcidc_.measure(steps_, applied_.pwm, applied_.duty, th,
                                    synrm_.d_axis().dynamic_inductance_H(cur.id0),
-                                   synrm_.q_axis().dynamic_inductance_H(cur.iq0), noise_);
+                                   synrm_.q_axis().dynamic_inductance_H(cur.iq0), noise_,
+                                   applied_.mcidc_window_shift);
   } else {
     mcidc_sample_.reset();
   }

@@ -165,6 +165,10 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("estimators.eemf.ld_H", &e.ld_H, "Sec. 6.2.3", "EEMF-CONST d inductance");
   b.pos("estimators.eemf.lq_H", &e.lq_H, "Sec. 6.2.3", "EEMF-CONST q inductance");
   b.pos("estimators.eemf.observer_bandwidth_Hz", &e.observer_bandwidth_Hz, "Sec. 6.2.3", "EEMF tracking observer bandwidth");
+  b.num("estimators.eemf.stiffness_margin", &e.stiffness_margin, 0, 100, "assumed",
+        "EEMF observer bandwidth at least this times the shaft's angle-error growth rate above the MTPA angle (0: off)", A);
+  b.num("estimators.eemf.speed_filter_s", &e.speed_filter_s, 0, 1, "assumed",
+        "low-pass time constant on the EEMF observer's reported speed (its proportional path's noise)", A);
   b.num("estimators.eemf.min_speed_rpm", &e.min_speed_rpm, 0, 10000, "Sec. 6.3.2", "below it EEMF hands over to the low-speed source");
   b.num("estimators.eemf.handover_hysteresis_rpm", &e.handover_hysteresis_rpm, 0, 1000, "assumed",
         "hysteresis around the minimum speed", A);

@@ -284,6 +284,9 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     u_est_alpha = ualpha - (limited_ ? comp_alpha * u_max / mag : comp_alpha);
     u_est_beta = ubeta - (limited_ ? comp_beta * u_max / mag : comp_beta);
     out.duty = InverterModel::duties(ualpha, ubeta, s.udc_V);
+    // Centre-aligned SVM near 50 % duty leaves no active vector long enough for the DC-link
+    // current slope, and an MCIDC-only EKF would run blind from standstill up to tens of volts.
+    out.mcidc_window_shift = needs_mcidc_ && pwm_ == drivers::Pwm::capwm;
   }
   u_hist_[1][0] = u_hist_[0][0];
   u_hist_[1][1] = u_hist_[0][1];

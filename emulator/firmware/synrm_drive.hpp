@@ -36,6 +36,11 @@ struct DriveOutput {
   double ualpha_V = 0, ubeta_V = 0;  // phase-voltage reference after limit and compensation
   Phases duty{0.5, 0.5, 0.5};
   drivers::Pwm pwm = drivers::Pwm::capwm;
+  // CAPWM only: the modulator shifts one leg's pulse per period (a, b, c in turn; duty and edge
+  // count unchanged) to open an active window long enough for an MCIDC slope, which centre-
+  // aligned SVM lacks near 50 % duty, so an MCIDC estimator gets a sample every period
+  // (docs/estimators.md).
+  bool mcidc_window_shift = false;
 };
 
 class SynrmDriveFirmware {

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "emulator/twin_bench.hpp"
 
 namespace synbench::bench {
@@ -109,6 +111,42 @@ TEST(PointProcedure, ThermalPreconditionWarmsAColdMachineBeforeMeasuring) {
   ASSERT_TRUE(p.record().truth);
   EXPECT_NEAR(p.record().pm_W, p.record().truth->pm_W, 0.01 * p.record().truth->pm_W)
       << "measured at the point's own load, not the warm-up load";
+}
+
+}  // namespace
+}  // namespace synbench::bench
+
+namespace synbench::bench {
+namespace {
+
+// A drive that cannot hold the speed (here a braking torque beyond what the SynRM's current limit
+// gives; on the bench, a sensorless observer slipped off the rotor) is measured at once and
+// flagged, not left to wait out the gate's timeout at a stalled shaft.
+TEST(PointProcedure, ALostSpeedIsMeasuredAtOnceAndReported) {
+  emulator::TwinConfig cfg;
+  cfg.firmware.current_limit_A = 2.0;  // about 2 N m at most, against a 4 N m brake
+  emulator::TwinBench bench{cfg};
+  PointOptions opt;
+  opt.settle_timeout_s = 30.0;
+  const auto p = run_point(bench.devices(), bench.clock(), request(500, 4.0, 56), opt);
+  ASSERT_EQ(p.phase(), PointPhase::done) << p.error();
+  ASSERT_TRUE(p.has_record());
+  EXPECT_TRUE(p.speed_lost());
+  EXPECT_TRUE(p.record().unstable);
+  EXPECT_FALSE(p.record().fault);
+  EXPECT_LT(p.record().speed_meas_rpm, 400.0);
+  // Lost after 1 s off by more than 100 rpm (20 % of 500): far sooner than the 30 s timeout.
+  EXPECT_LT(p.record().settle_s, 8.0);
+  std::printf("lost speed: %.1f rpm measured, settle %.2f s\n", p.record().speed_meas_rpm,
+              p.record().settle_s);
+}
+
+TEST(PointProcedure, AHeldSpeedIsNotReportedLost) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  const auto p = run_point(bench.devices(), bench.clock(), request(500, 3.5, 56), PointOptions{});
+  ASSERT_TRUE(p.has_record());
+  EXPECT_FALSE(p.speed_lost());
+  EXPECT_FALSE(p.record().unstable);
 }
 
 }  // namespace

@@ -55,6 +55,23 @@ TEST(Mcidc, CapwmMissesShortActiveVectorsAndPicksTheLongerOne) {
   EXPECT_NEAR(s->reluctance_per_H, 1.1 * phase_reluctance(0.2, 2, 0.45, 0.12), 1e-12);
 }
 
+// With the window shift the modulator opens a window for one leg per period (a, b, c in turn),
+// also near 50 % duty where the plain CAPWM sample is missing.
+TEST(Mcidc, CapwmWindowShiftMeasuresEveryPhaseInTurn) {
+  McidcParams p;
+  p.noise_sigma_per_H = 0;
+  p.deformation_amplitude_per_H = 0;
+  Mcidc m(p, 1e-4);
+  Noise noise(1);
+  const Phases near_half{0.52, 0.49, 0.49};
+  for (std::uint64_t k = 0; k < 6; ++k) {
+    const auto s = m.measure(k, drivers::Pwm::capwm, near_half, 0.3, 0.45, 0.12, noise, true);
+    ASSERT_TRUE(s) << k;
+    EXPECT_EQ(s->phase, static_cast<int>(k % 3));
+    EXPECT_NEAR(s->reluctance_per_H, phase_reluctance(0.3, s->phase, 0.45, 0.12), 1e-12);
+  }
+}
+
 TEST(InverterModel, AspwmHasTwoThirdsOfTheEdges) {
   EXPECT_EQ(edges_per_period(drivers::Pwm::capwm), 12);
   EXPECT_EQ(edges_per_period(drivers::Pwm::aspwm), 8);

@@ -3,8 +3,9 @@
 // per point through the bench's point procedure. Issue "Sensorless estimators": |mean position
 // error| <= 7.5 deg and Ld, Lq within +/-30 % at every point, from 100 rpm. Prints the worst
 // figures (and every point with --verbose); exits 1 if a point faults or breaks a limit.
-// usage: estimator_grid [--smoke] [--verbose] [--csv FILE]
+// usage: estimator_grid [--smoke] [--capwm] [--verbose] [--csv FILE]
 //   --smoke: 2 speeds x 2 loads x 2 angles (the grid's corners), for ctest.
+//   --capwm: centre-aligned PWM instead of the thesis' ASPWM (a user may pick it).
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -43,13 +44,15 @@ void keep_worst(double v, double& worst, std::string& at, const std::string& her
 
 int main(int argc, char** argv) {
   bool smoke = false, verbose = false;
+  auto pwm = synbench::drivers::Pwm::aspwm;
   const char* csv_path = nullptr;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) smoke = true;
     else if (!std::strcmp(argv[i], "--verbose")) verbose = true;
+    else if (!std::strcmp(argv[i], "--capwm")) pwm = synbench::drivers::Pwm::capwm;
     else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
     else {
-      std::fprintf(stderr, "usage: %s [--smoke] [--verbose] [--csv FILE]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--smoke] [--capwm] [--verbose] [--csv FILE]\n", argv[0]);
       return 2;
     }
   }
@@ -73,7 +76,7 @@ int main(int argc, char** argv) {
           req.load_Nm = load;
           req.angle_deg = angle;
           req.estimator = e;
-          req.pwm = synbench::drivers::Pwm::aspwm;
+          req.pwm = pwm;
           const auto r = synbench::testing::measure(synbench::emulator::TwinConfig{}, req, 5.0);
           char here[96];
           std::snprintf(here, sizeof here, "%g rpm %g N m %g deg", speed, load, angle);

@@ -5,12 +5,17 @@
 
 namespace synbench::emulator::firmware {
 
-Eemf::Eemf(const EemfParams& p) : p_(p), fd_(p.flux_d), fq_(p.flux_q) {
+Eemf::Eemf(const EemfParams& p)
+    : p_(p), fd_(p.flux_d), fq_(p.flux_q), stiffness_(p.stiffness) {
   obs_.configure(p_.observer_bandwidth_Hz);
   eg_f_.configure(p_.emf_filter_s, p_.ts_s);
   ig_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   id_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   ed_f_.configure(p_.emf_filter_s, p_.ts_s);
+  ig_s_.configure(p_.stiffness_current_filter_s, p_.ts_s);
+  id_s_.configure(p_.stiffness_current_filter_s, p_.ts_s);
+  speed_f_.configure(p_.speed_filter_s, p_.ts_s);
+  wn_own_ = 2.0 * 3.14159265358979323846 * p_.observer_bandwidth_Hz;
   if (p_.model == EemfModel::rls) {
     rls_every_ = std::max(1, static_cast<int>(std::lround(p_.rls_sample_s / p_.ts_s)));
     rls_.emplace(p_.rls_forgetting, p_.rls_p0, rls_every_ * p_.ts_s);
@@ -92,10 +97,22 @@ void Eemf::update(const EstimatorInput& in) {
   // Table look-ups on smoothed currents: noise must not modulate the inductances.
   inductances(ig_f_.update(ig), id_f_.update(id), ld_dyn, lq);
   const double rs = (p_.model == EemfModel::rls && estimate_) ? estimate_->rs_ohm : p_.rs_ohm;
-  const double dig = have_prev_ ? (ig - ig_prev_) / ts : 0.0;
-  const double did = have_prev_ ? (id - id_prev_) / ts : 0.0;
-  ig_prev_ = ig;
-  id_prev_ = id;
+  // The current's derivative in a frame turning at the estimated ROTOR speed w, not at the
+  // estimated frame's own speed w + kp err: the observer's proportional path turns the frame
+  // against the rotor, and with the current loops holding i_g,d in that frame the rotor sees its
+  // current vector turn, a real L'd p i that the frame-relative derivative misses. Read as EEMF
+  // it is an angle error of about (kp err / w) tan(th_i) L'd / (Ld - Lq): a positive feedback
+  // above unity gain from about 50 deg at 500 rpm, which is why the observer lost lock at high
+  // current angles in the sweeps and could not take a higher bandwidth (docs/estimators.md).
+  double dig = 0.0, did = 0.0;
+  if (have_prev_) {
+    const double thp = th - w * ts;
+    const double cp = std::cos(thp), sp = std::sin(thp);
+    dig = (ig - (cp * ia_prev_ + sp * ib_prev_)) / ts;
+    did = (id - (-sp * ia_prev_ + cp * ib_prev_)) / ts;
+  }
+  ia_prev_ = in.ialpha_A;
+  ib_prev_ = in.ibeta_A;
   have_prev_ = true;
   const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w * lq * id);
   const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w * lq * ig);
@@ -108,12 +125,18 @@ void Eemf::update(const EstimatorInput& in) {
   const double e0 = p_.emf_floor_V;
   const double err = 0.5 * std::atan2(-2.0 * eg * ed, ed * ed - eg * eg) * (e2 / (e2 + e0 * e0));
   obs_.correct(err, ts);
+  speed_f_.update(obs_.speed());
+  if (stiffness_.enabled()) {
+    const double igs = ig_s_.update(ig), ids = id_s_.update(id);
+    if (step_ % 10 == 0) obs_.set_natural_frequency(stiffness_.bandwidth_rad_s(wn_own_, igs, ids));
+  }
+  ++step_;
 }
 
 EstimatorOutput Eemf::output() const {
   EstimatorOutput o;
   o.theta_e_rad = obs_.theta();
-  o.omega_e_rad_s = obs_.speed();
+  o.omega_e_rad_s = speed_f_.value();
   if (estimate_) {
     o.rs_ohm = estimate_->rs_ohm;
     o.ld_H = estimate_->ld_H;

@@ -1,6 +1,8 @@
 // Extended-EMF observer (physics.md 8, thesis 2.12, 2.13, Sec. 6.2.3): in the estimated frame
 // e_g = u_g - (Rs + L'd p) i_g + w Lq i_d, e_d = u_d - (Rs + L'd p) i_d - w Lq i_g; the angle
-// error atan2(-e_g, e_d) drives a PI tracking observer (5 Hz) whose integral is the angle.
+// error atan2(-e_g, e_d) drives a PI tracking observer (5 Hz, raised where the shaft makes an
+// angle error grow) whose integral is the angle; p i is taken in a frame turning at the estimated
+// rotor speed, and the reported speed (the PI's output) is low-passed.
 // Three sources of Rs, L'd, Lq as in the thesis: constant (Ld = 0.65 H, Lq = 0.2 H), the
 // flux-map tables (optionally deformed, thesis 4.1 and 4.2), or RLS identification excited by
 // PRBS voltage injection on both axes.
@@ -10,6 +12,7 @@
 
 #include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/estimators/rls.hpp"
+#include "emulator/firmware/estimators/shaft_stiffness.hpp"
 #include "emulator/firmware/estimators/tracking_observer.hpp"
 #include "emulator/firmware/pi.hpp"
 #include "emulator/flux_map.hpp"
@@ -29,6 +32,11 @@ struct EemfParams {
   double lut_ld_scale = 1.0;            // kd of the table deformation L = k f(i / k) (4.1)
   double lut_lq_scale = 1.0;            // kq (4.2)
   double observer_bandwidth_Hz = 5.0;   // Sec. 6.2.3
+  // Raises the observer's bandwidth where the shaft makes an angle error grow (above the MTPA
+  // angle; shaft_stiffness.hpp), from the currents smoothed over `stiffness_current_filter_s`.
+  ShaftStiffnessParams stiffness;
+  double stiffness_current_filter_s = 0.02;  // [assumed]
+  double speed_filter_s = 0.0;          // [assumed] low-pass on the reported speed (0: none)
   double emf_filter_s = 5e-3;           // [assumed] low-pass on e before the angle error
   double emf_floor_V = 5.0;             // [assumed] |e| below which the angle error is faded out
   double rls_forgetting = 0.99;         // Sec. 6.2.3
@@ -45,7 +53,10 @@ class Eemf final : public Estimator {
   void update(const EstimatorInput& in) override;
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
-  void align(double theta_e_rad, double omega_e_rad_s) override { obs_.reset(theta_e_rad, omega_e_rad_s); }
+  void align(double theta_e_rad, double omega_e_rad_s) override {
+    obs_.reset(theta_e_rad, omega_e_rad_s);
+    speed_f_.reset(omega_e_rad_s);
+  }
 
  private:
   void inductances(double ig, double id, double& ld_dyn, double& lq_static) const;
@@ -54,7 +65,11 @@ class Eemf final : public Estimator {
   FluxAxis fd_, fq_;
   TrackingObserver obs_;
   LowPass eg_f_, ed_f_, ig_f_, id_f_;
-  double ig_prev_ = 0, id_prev_ = 0;
+  ShaftStiffness stiffness_;
+  LowPass ig_s_, id_s_, speed_f_;
+  double wn_own_ = 0;
+  long step_ = 0;
+  double ia_prev_ = 0, ib_prev_ = 0;  // the last current sample, stationary frame
   bool have_prev_ = false;
   // RLS and its excitation.
   std::optional<StatorRls> rls_;

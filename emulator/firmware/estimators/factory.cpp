@@ -48,6 +48,9 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   p.lut_ld_scale = e.lut_ld_scale;
   p.lut_lq_scale = e.lut_lq_scale;
   p.observer_bandwidth_Hz = e.observer_bandwidth_Hz;
+  p.stiffness = stiffness(config);
+  p.stiffness.margin = e.stiffness_margin;
+  p.speed_filter_s = e.speed_filter_s;
   p.rls_forgetting = e.rls_forgetting;
   p.rls_p0 = e.rls_p0;
   p.rls_sample_s = e.rls_sample_s;

@@ -7,15 +7,21 @@ namespace synbench::emulator::firmware {
 
 LowSpeedHandover::LowSpeedHandover(std::unique_ptr<Estimator> main,
                                    std::unique_ptr<Estimator> fallback, double min_speed_rad_s,
-                                   double hysteresis_rad_s)
+                                   double hysteresis_rad_s, double speed_filter_s)
     : main_(std::move(main)), fallback_(std::move(fallback)), min_(min_speed_rad_s),
-      hyst_(hysteresis_rad_s) {}
+      hyst_(hysteresis_rad_s), speed_filter_s_(speed_filter_s) {}
 
 void LowSpeedHandover::update(const EstimatorInput& in) {
+  if (!filters_configured_) {
+    main_speed_.configure(speed_filter_s_, in.ts_s);
+    fallback_speed_.configure(speed_filter_s_, in.ts_s);
+    filters_configured_ = true;
+  }
   if (main_active_) {
     main_->update(in);
     const EstimatorOutput o = main_->output();
-    if (std::fabs(o.omega_e_rad_s) < min_ - 2.0 * hyst_) {
+    fallback_speed_.reset(main_speed_.update(o.omega_e_rad_s));
+    if (std::fabs(main_speed_.value()) < min_ - 2.0 * hyst_) {
       main_active_ = false;
       if (fallback_) fallback_->align(o.theta_e_rad, o.omega_e_rad_s);
     }
@@ -30,7 +36,8 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
   }
   main_->update(in);
   main_->align(fallback_out_.theta_e_rad, fallback_out_.omega_e_rad_s);
-  if (std::fabs(fallback_out_.omega_e_rad_s) > min_ - hyst_) main_active_ = true;
+  main_speed_.reset(fallback_speed_.update(fallback_out_.omega_e_rad_s));
+  if (std::fabs(fallback_speed_.value()) > min_ - hyst_) main_active_ = true;
 }
 
 EstimatorOutput LowSpeedHandover::output() const {

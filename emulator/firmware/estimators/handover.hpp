@@ -1,12 +1,16 @@
 // Below its minimum speed an EEMF observer hands the angle to another source — HFI or the
 // encoder — as the thesis did below 500 rpm; it keeps running aligned to that source, so it
 // takes over without a jump when the speed rises again. It takes over a hysteresis below the
-// minimum speed (so a point at the minimum speed runs on it) and hands back two below.
+// minimum speed (so a point at the minimum speed runs on it) and hands back two below. The
+// decisions look at speeds smoothed over `speed_filter_s`: an observer's reported speed carries
+// its proportional path, tens of rpm of noise per sample that would flip the source back and
+// forth (each flip re-aligns the observer).
 #pragma once
 
 #include <memory>
 
 #include "emulator/firmware/estimators/estimator.hpp"
+#include "emulator/firmware/pi.hpp"
 
 namespace synbench::emulator::firmware {
 
@@ -14,7 +18,7 @@ class LowSpeedHandover final : public Estimator {
  public:
   // `fallback` null means the encoder.
   LowSpeedHandover(std::unique_ptr<Estimator> main, std::unique_ptr<Estimator> fallback,
-                   double min_speed_rad_s, double hysteresis_rad_s);
+                   double min_speed_rad_s, double hysteresis_rad_s, double speed_filter_s = 0.02);
   void update(const EstimatorInput& in) override;
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
@@ -24,7 +28,9 @@ class LowSpeedHandover final : public Estimator {
 
  private:
   std::unique_ptr<Estimator> main_, fallback_;
-  double min_, hyst_;
+  double min_, hyst_, speed_filter_s_;
+  LowPass main_speed_, fallback_speed_;
+  bool filters_configured_ = false;
   bool main_active_ = false;
   EstimatorOutput fallback_out_;
 };
