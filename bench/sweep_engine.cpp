@@ -138,12 +138,13 @@ void SweepEngine::finish_point(double /*now_s*/) {
                   "the drives for the next point",
                   static_cast<std::size_t>(n.point.index), r.speed_rpm, r.speed_meas_rpm);
     sink_.event("log", what);
-    begin_stop(SweepState::running, now_);
+    begin_stop(SweepState::running, now_, /*coast=*/true);
   }
 }
 
-void SweepEngine::begin_stop(SweepState final_state, double now_s) {
+void SweepEngine::begin_stop(SweepState final_state, double now_s, bool coast) {
   stopping_ = true;
+  coast_ = coast;
   after_stop_ = final_state;
   stop_since_s_ = now_s;
   if (final_state != SweepState::running) state_ = SweepState::stopping;
@@ -156,7 +157,7 @@ void SweepEngine::tick_stop(double now_s) {
   const bool load_gone = lt && std::fabs(lt->torque_Nm) < 0.05;
   if (load_gone || now_s - stop_since_s_ > kStopLoadTimeout_s) dev_.synrm->set_speed_rpm(0.0);
   const bool still = st && std::fabs(st->speed_rpm) < kStoppedRpm;
-  if ((still && load_gone) || now_s - stop_since_s_ > kStopSpeedTimeout_s) {
+  if ((still && load_gone) || (coast_ && load_gone) || now_s - stop_since_s_ > kStopSpeedTimeout_s) {
     dev_.synrm->enable(false);
     dev_.load->enable(false);
     stopping_ = false;

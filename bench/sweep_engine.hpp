@@ -78,7 +78,9 @@ class SweepEngine {
   std::optional<Next> next_point();
   void start_point(const Next& n, double now_s);
   void finish_point(double now_s);
-  void begin_stop(SweepState final_state, double now_s);
+  // `coast`: once the load torque is gone, disable at once instead of commanding zero speed (a
+  // drive that lost the rotor cannot be trusted to decelerate it).
+  void begin_stop(SweepState final_state, double now_s, bool coast = false);
   void tick_stop(double now_s);
 
   drivers::BenchDevices dev_;
@@ -102,7 +104,7 @@ class SweepEngine {
   std::unique_ptr<PointProcedure> proc_;
   std::optional<Configuration> running_config_;
   // The ordered stop between configurations or at the end.
-  bool stopping_ = false;
+  bool stopping_ = false, coast_ = false;
   SweepState after_stop_ = SweepState::completed;
   double stop_since_s_ = 0;
   double t0_ = -1, now_ = 0;

@@ -74,6 +74,10 @@ std::error_code SynrmDriveFirmware::enable(bool on) {
   if (state_ == drivers::DriveState::faulted) return make_error_code(errc::device_fault);
   if (state_ == drivers::DriveState::running) return {};
   state_ = drivers::DriveState::running;
+  // A sensorless estimator starts afresh from its initial state on every enable: while the gates
+  // were off it saw no current and drifted. (An EEMF observer then starts on its low-speed source,
+  // which hands over at once, aligned, when the shaft still turns above the minimum speed.)
+  if (estimator_) estimator_ = make_estimator(estimator_kind_, cfg_).estimator;
   speed_ref_rpm_ = obs_omega_ * kRpmPerRadS;
   speed_pi_.reset();
   id_pi_.reset();

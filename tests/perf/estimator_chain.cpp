@@ -46,19 +46,13 @@ struct Tally {
   double worst_in_lock_deg = 0, settle_sum_s = 0;
 };
 
-// Load torque to zero, then the speed, then disable (what bench::SweepEngine does between
-// configurations and after a lost point).
+// What bench::SweepEngine does after a lost point: load torque to zero, then disable (the
+// shaft coasts; a drive that lost the rotor is not asked to decelerate it).
 void ordered_stop(synbench::emulator::TwinBench& bench) {
   auto dev = bench.devices();
   auto& clock = bench.clock();
   dev.load->set_torque_Nm(0.0);
   clock.wait_until(clock.now_s() + 1.0);
-  dev.synrm->set_speed_rpm(0.0);
-  const double give_up = clock.now_s() + 30.0;
-  synbench::drivers::SynrmTelemetry st;
-  do {
-    clock.wait_until(clock.now_s() + 0.01);
-  } while (!dev.synrm->read(st) && std::fabs(st.speed_rpm) > 20.0 && clock.now_s() < give_up);
   dev.synrm->enable(false);
   dev.load->enable(false);
 }
