@@ -6,7 +6,7 @@
 // slipping observer sweeps the whole (-90, 90] deg), the worst |mean position error| in lock, the
 // mean settling time and the wall time. Exits 1 when a point faults.
 // usage: estimator_chain --estimator NAME [--pwm capwm|aspwm] [--speeds a,b,..] [--loads ..]
-//                        [--angles ..] [--timeout-s S] [--verbose]
+//                        [--angles ..] [--timeout-s S] [--config FILE] [--verbose]
 //   defaults: the thesis grid (EEMF variants from 500 rpm), the thesis PWM of the estimator,
 //   the gate timeout of bench::PointOptions.
 #include <chrono>
@@ -14,12 +14,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "bench/point_procedure.hpp"
 #include "emulator/twin_bench.hpp"
+#include "emulator/twin_config_schema.hpp"
 
 namespace {
 
@@ -64,6 +66,7 @@ int main(int argc, char** argv) {
   std::optional<Pwm> pwm;
   std::vector<double> speeds, loads = range(0.5, 3.5, 0.5), angles = range(40, 76, 2);
   std::optional<double> timeout_s;
+  const char* config_path = nullptr;
   bool verbose = false;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
@@ -80,6 +83,8 @@ int main(int argc, char** argv) {
       angles = list(argv[++i]);
     } else if (!std::strcmp(argv[i], "--timeout-s") && has_value) {
       timeout_s = std::strtod(argv[++i], nullptr);
+    } else if (!std::strcmp(argv[i], "--config") && has_value) {
+      config_path = argv[++i];
     } else if (!std::strcmp(argv[i], "--verbose")) {
       verbose = true;
     } else {
@@ -90,7 +95,7 @@ int main(int argc, char** argv) {
   if (e == Estimator::encoder) {
     std::fprintf(stderr,
                  "usage: %s --estimator NAME [--pwm capwm|aspwm] [--speeds a,b,..] [--loads ..] "
-                 "[--angles ..] [--timeout-s S] [--verbose]\n  NAME: a sensorless estimator "
+                 "[--angles ..] [--timeout-s S] [--config FILE] [--verbose]\n  NAME: a sensorless estimator "
                  "(ekf-basic, ekf-rs, hfi, eemf-const, eemf-lut, eemf-rls)\n",
                  argv[0]);
     return 2;
@@ -101,6 +106,12 @@ int main(int argc, char** argv) {
   if (!pwm) pwm = ekf ? Pwm::aspwm : Pwm::capwm;
 
   synbench::emulator::TwinConfig cfg;
+  try {
+    if (config_path) cfg = synbench::emulator::load_twin_config_file(config_path);
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "%s\n", ex.what());
+    return 2;
+  }
   synbench::emulator::TwinBench bench(cfg);
   synbench::bench::PointOptions opt;
   opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
