@@ -43,6 +43,8 @@ const char* kSmall = R"({
 })";
 
 struct TwinRun {
+  TwinRun() = default;
+  explicit TwinRun(const emulator::TwinConfig& config) : bench{config} {}
   emulator::TwinBench bench{emulator::TwinConfig{}};
   SafetySupervisor sup{bench.devices(), SafetyLimits{}};
   double t = 0;
@@ -157,6 +159,44 @@ TEST(SweepEngine, EndsFaultedWhenTheSupervisorTrips) {
   EXPECT_NE(e.error().find("overtemperature"), std::string::npos) << e.error();
   EXPECT_LE(sink.points.size(), 4u);
   EXPECT_TRUE(run.sup.tripped());
+}
+
+}  // namespace
+}  // namespace synbench::bench
+
+namespace synbench::bench {
+namespace {
+
+// A point whose drive cannot hold the speed (here the brake exceeds what the SynRM's current
+// limit gives; on the bench, a sensorless observer that slipped) is recorded unstable at once,
+// logged, and the drives are stopped so that the next point starts from standstill and is
+// measured normally; nothing faults.
+TEST(SweepEngine, RestartsTheDrivesAfterAPointThatLostTheSpeed) {
+  emulator::TwinConfig cfg;
+  cfg.firmware.current_limit_A = 1.5;  // about 1.5 N m at most, against a 3.5 N m brake
+  TwinRun run{cfg};
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(R"({
+    "name": "lost",
+    "dimensions": {"speed_rpm": [500], "load_Nm": [3.5, 0.5], "angle_deg": [56]},
+    "window_s": 0.5,
+    "thermal": {"enabled": false}
+  })"), {}, sink);
+  run.until(e, 300);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 2u);
+  const auto& lost = sink.points[0].second;
+  const auto& next = sink.points[1].second;
+  EXPECT_TRUE(lost.unstable);
+  EXPECT_FALSE(lost.fault);
+  EXPECT_LT(lost.speed_meas_rpm, 400.0);
+  EXPECT_LT(lost.settle_s, 8.0) << "measured at once, not after the gate's timeout";
+  EXPECT_FALSE(next.unstable);
+  EXPECT_NEAR(next.speed_meas_rpm, 500.0, 1.0);
+  bool logged = false;
+  for (const auto& ev : sink.events)
+    logged = logged || ev.find("could not hold 500 rpm") != std::string::npos;
+  EXPECT_TRUE(logged);
 }
 
 }  // namespace
