@@ -126,12 +126,8 @@ int main(int argc, char** argv) {
   for (double speed : speeds) {
     for (double load : loads) {
       for (double angle : angles) {
-        synbench::bench::PointRequest req;
-        req.speed_rpm = speed;
-        req.load_Nm = load;
-        req.angle_deg = angle;
-        req.estimator = e;
-        req.pwm = *pwm;
+        const synbench::bench::PointRequest req{
+            .speed_rpm = speed, .load_Nm = load, .angle_deg = angle, .estimator = e, .pwm = *pwm};
         const auto proc = synbench::bench::run_point(bench.devices(), bench.clock(), req, opt);
         const auto& r = proc.record();
         // As the sweep engine does: a drive that lost the speed is stopped in order and the next

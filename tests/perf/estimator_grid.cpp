@@ -71,12 +71,8 @@ int main(int argc, char** argv) {
     for (double speed : speeds)
       for (double load : loads)
         for (double angle : angles) {
-          synbench::bench::PointRequest req;
-          req.speed_rpm = speed;
-          req.load_Nm = load;
-          req.angle_deg = angle;
-          req.estimator = e;
-          req.pwm = pwm;
+          const synbench::bench::PointRequest req{
+              .speed_rpm = speed, .load_Nm = load, .angle_deg = angle, .estimator = e, .pwm = pwm};
           const auto r = synbench::testing::measure(synbench::emulator::TwinConfig{}, req, 5.0);
           char here[96];
           std::snprintf(here, sizeof here, "%g rpm %g N m %g deg", speed, load, angle);
