@@ -108,7 +108,8 @@ double mean_abs_pos_err_700(drivers::Estimator e, const emulator::TwinConfig& cf
 }
 
 // At 700 rpm: EEMF-CONST has the largest mean |position error| over the loads; EEMF-LUT with
-// exact tables is better, and worse again with a deformed table (thesis 4.1, 4.2).
+// exact tables is better, and worse again with a deformed table, Lq or Ld x 1.25 (thesis 4.1,
+// 4.2).
 TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
   emulator::TwinConfig cfg;
   const double konst = mean_abs_pos_err_700(drivers::Estimator::eemf_const, cfg);
@@ -116,11 +117,16 @@ TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
   const double ekf = mean_abs_pos_err_700(drivers::Estimator::ekf_basic, cfg);
   cfg.estimators.eemf.lut_lq_scale = 1.25;
   const double lut_off = mean_abs_pos_err_700(drivers::Estimator::eemf_lut, cfg);
+  cfg.estimators.eemf.lut_lq_scale = 1.0;
+  cfg.estimators.eemf.lut_ld_scale = 1.25;
+  const double lut_ld_off = mean_abs_pos_err_700(drivers::Estimator::eemf_lut, cfg);
   std::printf("700 rpm mean |pos err|: EEMF-CONST %.2f, EEMF-LUT %.2f, EKF-BASIC %.2f, "
-              "EEMF-LUT Lq x1.25 %.2f deg\n", konst, lut, ekf, lut_off);
+              "EEMF-LUT Lq x1.25 %.2f, EEMF-LUT Ld x1.25 %.2f deg\n", konst, lut, ekf, lut_off, lut_ld_off);
   EXPECT_GT(konst, lut + 2.0);
   EXPECT_GT(konst, ekf);
   EXPECT_GT(lut_off, lut + 1.0);
+  // Ld only multiplies p i (physics.md 8): a wrong Ld costs less than a wrong Lq, but it costs.
+  EXPECT_GT(lut_ld_off, lut + 0.5);
   EXPECT_LT(lut, 4.0);
 }
 
