@@ -36,9 +36,36 @@ void PointProcedure::enter(PointPhase p, double now_s) {
 }
 
 void PointProcedure::begin_stop(double now_s) {
-  // Ordered stop, step one: the load first, so the SynRM is never driven by the load.
+  // Ordered stop, step one: the load first, so the SynRM is never driven by the load. Not
+  // ramped by the bench: the load drive ramps it, and a stop must not wait on the bench's ticks.
   dev_.load->set_torque_Nm(0.0);
+  load_cmd_Nm_ = load_target_Nm_ = 0.0;
+  load_pending_ = false;
   enter(PointPhase::stop, now_s);
+}
+
+void PointProcedure::command_load(double target_Nm) {
+  load_target_Nm_ = target_Nm;
+  load_pending_ = true;
+}
+
+bool PointProcedure::ramp_load(double now_s) {
+  const double dt = t_last_tick_ < 0 ? 0.0 : now_s - t_last_tick_;
+  t_last_tick_ = now_s;
+  if (!load_pending_) return true;
+  if (opt_.load_ramp_Nm_per_s <= 0) {
+    load_cmd_Nm_ = load_target_Nm_;
+  } else {
+    const double step = opt_.load_ramp_Nm_per_s * dt;
+    const double next = load_cmd_Nm_ + std::clamp(load_target_Nm_ - load_cmd_Nm_, -step, step);
+    // Intermediate setpoints on a 1/1024 N m grid, exact in a 32-bit float register: the ramp
+    // commands the same torques over Modbus as in-process.
+    // (A ramp slower than one grid step per tick moves unrounded rather than not at all.)
+    const double on_grid = std::round(next * 1024.0) / 1024.0;
+    load_cmd_Nm_ = (next == load_target_Nm_ || on_grid == load_cmd_Nm_) ? next : on_grid;
+  }
+  load_pending_ = load_cmd_Nm_ != load_target_Nm_;
+  return check(dev_.load->set_torque_Nm(load_cmd_Nm_), "setting load torque");
 }
 
 void PointProcedure::tick(double now_s) {
@@ -55,6 +82,7 @@ void PointProcedure::tick(double now_s) {
       begin_stop(now_s);
       return;
     }
+    if (phase_ != PointPhase::stop && !ramp_load(now_s)) return;
   }
 
   switch (phase_) {
@@ -68,12 +96,16 @@ void PointProcedure::tick(double now_s) {
         return;
       }
       if (opt_.continue_running && st.state == drivers::DriveState::running) {
-        // Retarget a running bench: everything at once, then let the gate judge.
+        // Retarget a running bench: everything at once (the load at its ramp, from the setpoint
+        // in force), then let the gate judge.
+        if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
         if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
         if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
         if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
         if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
-        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        load_cmd_Nm_ = lt.torque_Nm;
+        command_load(req_.load_Nm);
+        t_last_tick_ = now_s;
         enter(PointPhase::load_up, now_s);
         return;
       }
@@ -91,7 +123,7 @@ void PointProcedure::tick(double now_s) {
       const bool reached = std::fabs(st.speed_rpm - req_.speed_rpm) < opt_.speed_reached_band_rpm;
       if (reached || now_s - t_phase_ > opt_.spin_up_timeout_s) {
         if (!reached) record_.unstable = true;
-        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        command_load(req_.load_Nm);
         enter(PointPhase::load_up, now_s);
       }
       return;
@@ -131,9 +163,7 @@ void PointProcedure::tick(double now_s) {
           if (now_s - t_thermal_ <= opt_.thermal->timeout_s) {
             // Warm with load or cool unloaded, then come back and settle again.
             const bool cold = st.temp_C < opt_.thermal->target_C;
-            if (!check(dev_.load->set_torque_Nm(cold ? opt_.thermal->warmup_load_Nm : 0.0),
-                       "setting the thermal-conditioning load"))
-              return;
+            command_load(cold ? opt_.thermal->warmup_load_Nm : 0.0);
             enter(PointPhase::thermal, now_s);
             return;
           }
@@ -151,7 +181,7 @@ void PointProcedure::tick(double now_s) {
       const auto& th = *opt_.thermal;
       const bool inside = std::fabs(st.temp_C - th.target_C) < 0.5 * th.band_C;
       if (inside || now_s - t_thermal_ > th.timeout_s) {
-        if (!check(dev_.load->set_torque_Nm(req_.load_Nm), "setting load torque")) return;
+        command_load(req_.load_Nm);
         enter(PointPhase::load_up, now_s);
       }
       return;

@@ -37,6 +37,11 @@ struct PointOptions {
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
   // new setpoints are commanded together and the gate decides when the bench has settled.
   bool continue_running = false;
+  // The bench moves the load torque setpoint at this rate (0: steps it). A sensorless observer
+  // must track the deceleration the load change causes until the 3 Hz speed loop answers: a
+  // 2.5 N m step (ramped by the load drive within 0.25 s) stalled EEMF-LUT at 700 rpm, 56 deg
+  // (a PI tracking loop lags an acceleration alpha by alpha / wn^2), 2 N m/s did not.
+  double load_ramp_Nm_per_s = 2.0;
   // A drive that cannot hold the commanded speed while settling (a sensorless observer that lost
   // the rotor: the shaft stalls while the estimate spins on) is measured at once, flagged
   // unstable and reported by speed_lost(), instead of waiting out the gate's timeout (a sweep
@@ -74,6 +79,9 @@ class PointProcedure {
 
  private:
   bool check(std::error_code ec, const char* what);
+  // The load torque the procedure wants; ramp_load() moves the setpoint there each tick.
+  void command_load(double target_Nm);
+  bool ramp_load(double now_s);
   void begin_stop(double now_s);
   void read_results();
   void enter(PointPhase p, double now_s);
@@ -85,6 +93,8 @@ class PointProcedure {
   PointPhase phase_ = PointPhase::start;
   double t_start_ = 0, t_phase_ = 0, t_window_ = 0, t_thermal_ = -1, t_off_speed_ = -1;
   bool has_record_ = false, speed_lost_ = false;
+  double load_cmd_Nm_ = 0, load_target_Nm_ = 0, t_last_tick_ = -1;
+  bool load_pending_ = false;
   PointRecord record_;
   std::string error_;
 };

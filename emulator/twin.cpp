@@ -103,7 +103,10 @@ void Twin::step() {
     window_pending_ = 0;
     synrm_fw_.begin_window(window_left_);
     load_fw_.begin_window(window_left_);
-    vfc_.open_gate(time_s());
+    // The meter times its gate from the gate edge (its own time base): whole periods, exactly,
+    // wherever on the twin's clock the window starts.
+    vfc_.open_gate(0.0);
+    window_steps_ = window_left_;
     t_pin_ = t_pcu_ = t_pfe_ = t_pmech_ = t_pinv_ = t_pm_ = t_temp_ = 0;
   }
 
@@ -188,7 +191,7 @@ void Twin::step() {
     t_pm_ += 0.5 * (k1.pm_W + k2.pm_W);
     t_temp_ += thermal_.temp_C();
     if (--window_left_ == 0) {
-      vfc_.close_gate(time_s());
+      vfc_.close_gate(static_cast<double>(window_steps_) * ts_);
       const double n = std::round(vfc_.reading().gate_s / ts_);
       truth_ = drivers::TruthWindow{t_pin_ / n,   t_pcu_ / n, t_pfe_ / n, t_pmech_ / n,
                                     t_pinv_ / n,  t_pm_ / n,  t_temp_ / n};

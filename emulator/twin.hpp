@@ -106,7 +106,7 @@ class Twin {
   double load_iref_A_ = 0;
   std::optional<McidcSample> mcidc_sample_;
 
-  std::int64_t window_pending_ = 0, window_left_ = 0;
+  std::int64_t window_pending_ = 0, window_left_ = 0, window_steps_ = 0;
   double t_pin_ = 0, t_pcu_ = 0, t_pfe_ = 0, t_pmech_ = 0, t_pinv_ = 0, t_pm_ = 0, t_temp_ = 0;
   std::optional<drivers::TruthWindow> truth_;
 };

@@ -129,7 +129,7 @@ struct EemfConfig {
   double lq_H = 0.2;
   double observer_bandwidth_Hz = 5.0;
   double stiffness_margin = 1.5;   // observer wn >= margin x the shaft's error growth rate (as HFI)
-  double speed_filter_s = 0.005;   // low-pass on the speed the observer reports
+  double speed_filter_s = 0.002;   // low-pass on the speed the observer reports
   double min_speed_rpm = 500.0;
   double handover_hysteresis_rpm = 25.0;
   std::string low_speed_source = "encoder";

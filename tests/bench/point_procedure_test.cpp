@@ -151,3 +151,39 @@ TEST(PointProcedure, AHeldSpeedIsNotReportedLost) {
 
 }  // namespace
 }  // namespace synbench::bench
+
+namespace synbench::bench {
+namespace {
+
+// Time the load torque takes from 0.1 N m to 2.9 N m on its way to 3 N m.
+double load_rise_s(double ramp_Nm_per_s) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  PointOptions opt;
+  opt.load_ramp_Nm_per_s = ramp_Nm_per_s;
+  PointProcedure p(bench.devices(), request(700, 3.0, 52), opt);
+  double t = 0, t_low = -1, t_high = -1;
+  while (!p.finished() && t < 60 && t_high < 0) {
+    t += opt.tick_s;
+    bench.clock().wait_until(t);
+    p.tick(t);
+    drivers::LoadTelemetry lt;
+    EXPECT_FALSE(bench.devices().load->read(lt));
+    if (t_low < 0 && lt.torque_Nm > 0.1) t_low = t;
+    if (t_high < 0 && lt.torque_Nm > 2.9) t_high = t;
+  }
+  EXPECT_GT(t_low, 0);
+  EXPECT_GT(t_high, 0);
+  return t_high - t_low;
+}
+
+// The bench moves the load setpoint at its ramp (a sensorless observer must follow the shaft's
+// deceleration); with the ramp off the load drive's own 10 N m/s rules.
+TEST(PointProcedure, RampsTheLoadTorqueAtItsRate) {
+  const double ramped = load_rise_s(2.0), stepped = load_rise_s(0.0);
+  std::printf("0.1 -> 2.9 N m: %.2f s at 2 N m/s, %.2f s stepped\n", ramped, stepped);
+  EXPECT_NEAR(ramped, 2.8 / 2.0, 0.15);
+  EXPECT_LT(stepped, 0.5);
+}
+
+}  // namespace
+}  // namespace synbench::bench
