@@ -44,6 +44,13 @@ void PointProcedure::begin_stop(double now_s) {
   enter(PointPhase::stop, now_s);
 }
 
+void PointProcedure::open_window(double now_s) {
+  if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
+  t_window_ = now_s;
+  record_.settle_s = now_s - t_start_;
+  enter(PointPhase::measure, now_s);
+}
+
 void PointProcedure::command_load(double target_Nm) {
   load_target_Nm_ = target_Nm;
   load_pending_ = true;
@@ -150,10 +157,7 @@ void PointProcedure::tick(double now_s) {
       const bool timed_out = now_s - t_phase_ > opt_.settle_timeout_s;
       if (speed_lost_) {
         record_.unstable = true;
-        if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
-        t_window_ = now_s;
-        record_.settle_s = now_s - t_start_;
-        enter(PointPhase::measure, now_s);
+        open_window(now_s);
         return;
       }
       if (settled || timed_out) {
@@ -169,10 +173,7 @@ void PointProcedure::tick(double now_s) {
           }
           record_.unstable = true;  // measured outside the thermal window after the timeout
         }
-        if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
-        t_window_ = now_s;
-        record_.settle_s = now_s - t_start_;
-        enter(PointPhase::measure, now_s);
+        open_window(now_s);
       }
       return;
     }

@@ -79,6 +79,8 @@ class PointProcedure {
 
  private:
   bool check(std::error_code ec, const char* what);
+  // Opens the window on every instrument at once and measures (phase measure).
+  void open_window(double now_s);
   // The load torque the procedure wants; ramp_load() moves the setpoint there each tick.
   void command_load(double target_Nm);
   bool ramp_load(double now_s);
