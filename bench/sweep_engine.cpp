@@ -1,7 +1,6 @@
 // The sweep engine's state machine.
 #include "bench/sweep_engine.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 

@@ -6,16 +6,14 @@
 namespace synbench::emulator::firmware {
 
 Eemf::Eemf(const EemfParams& p)
-    : p_(p), fd_(p.flux_d), fq_(p.flux_q), stiffness_(p.stiffness) {
+    : p_(p), fd_(p.flux_d), fq_(p.flux_q),
+      tuner_(p.stiffness, p.observer_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s) {
   obs_.configure(p_.observer_bandwidth_Hz);
   eg_f_.configure(p_.emf_filter_s, p_.ts_s);
   ig_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   id_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   ed_f_.configure(p_.emf_filter_s, p_.ts_s);
-  ig_s_.configure(p_.stiffness_current_filter_s, p_.ts_s);
-  id_s_.configure(p_.stiffness_current_filter_s, p_.ts_s);
   speed_f_.configure(p_.speed_filter_s, p_.ts_s);
-  wn_own_ = 2.0 * 3.14159265358979323846 * p_.observer_bandwidth_Hz;
   if (p_.model == EemfModel::rls) {
     rls_every_ = std::max(1, static_cast<int>(std::lround(p_.rls_sample_s / p_.ts_s)));
     rls_.emplace(p_.rls_forgetting, p_.rls_p0, rls_every_ * p_.ts_s);
@@ -126,11 +124,7 @@ void Eemf::update(const EstimatorInput& in) {
   const double err = 0.5 * std::atan2(-2.0 * eg * ed, ed * ed - eg * eg) * (e2 / (e2 + e0 * e0));
   obs_.correct(err, ts);
   speed_f_.update(obs_.speed());
-  if (stiffness_.enabled()) {
-    const double igs = ig_s_.update(ig), ids = id_s_.update(id);
-    if (step_ % 10 == 0) obs_.set_natural_frequency(stiffness_.bandwidth_rad_s(wn_own_, igs, ids));
-  }
-  ++step_;
+  tuner_.update(obs_, ig, id);
 }
 
 EstimatorOutput Eemf::output() const {

@@ -65,10 +65,8 @@ class Eemf final : public Estimator {
   FluxAxis fd_, fq_;
   TrackingObserver obs_;
   LowPass eg_f_, ed_f_, ig_f_, id_f_;
-  ShaftStiffness stiffness_;
-  LowPass ig_s_, id_s_, speed_f_;
-  double wn_own_ = 0;
-  long step_ = 0;
+  StiffnessTuner tuner_;
+  LowPass speed_f_;
   double ia_prev_ = 0, ib_prev_ = 0;  // the last current sample, stationary frame
   bool have_prev_ = false;
   // RLS and its excitation.

@@ -7,16 +7,15 @@ namespace synbench::emulator::firmware {
 
 LowSpeedHandover::LowSpeedHandover(std::unique_ptr<Estimator> main,
                                    std::unique_ptr<Estimator> fallback, double min_speed_rad_s,
-                                   double hysteresis_rad_s, double speed_filter_s)
+                                   double hysteresis_rad_s, double ts_s,
+                                   double speed_filter_s)
     : main_(std::move(main)), fallback_(std::move(fallback)), min_(min_speed_rad_s),
-      hyst_(hysteresis_rad_s), speed_filter_s_(speed_filter_s) {}
+      hyst_(hysteresis_rad_s) {
+  main_speed_.configure(speed_filter_s, ts_s);
+  fallback_speed_.configure(speed_filter_s, ts_s);
+}
 
 void LowSpeedHandover::update(const EstimatorInput& in) {
-  if (!filters_configured_) {
-    main_speed_.configure(speed_filter_s_, in.ts_s);
-    fallback_speed_.configure(speed_filter_s_, in.ts_s);
-    filters_configured_ = true;
-  }
   if (main_active_) {
     main_->update(in);
     const EstimatorOutput o = main_->output();

@@ -18,7 +18,8 @@ class LowSpeedHandover final : public Estimator {
  public:
   // `fallback` null means the encoder.
   LowSpeedHandover(std::unique_ptr<Estimator> main, std::unique_ptr<Estimator> fallback,
-                   double min_speed_rad_s, double hysteresis_rad_s, double speed_filter_s = 0.02);
+                   double min_speed_rad_s, double hysteresis_rad_s, double ts_s,
+                   double speed_filter_s = 0.02);
   void update(const EstimatorInput& in) override;
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
@@ -28,9 +29,8 @@ class LowSpeedHandover final : public Estimator {
 
  private:
   std::unique_ptr<Estimator> main_, fallback_;
-  double min_, hyst_, speed_filter_s_;
+  double min_, hyst_;
   LowPass main_speed_, fallback_speed_;
-  bool filters_configured_ = false;
   bool main_active_ = false;
   EstimatorOutput fallback_out_;
 };

@@ -8,7 +8,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 }
 
-Hfi::Hfi(const HfiParams& p) : p_(p), stiffness_(p.stiffness) {
+Hfi::Hfi(const HfiParams& p)
+    : p_(p), tuner_(p.stiffness, p.pll_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s) {
   w_hf_ = 2.0 * kPi * p_.frequency_Hz;
   // A command computed now acts over the period after next: its centre is 1.5 periods later.
   delay_rad_ = 1.5 * w_hf_ * p_.ts_s;
@@ -18,9 +19,6 @@ Hfi::Hfi(const HfiParams& p) : p_(p), stiffness_(p.stiffness) {
   bp_q_.configure(p_.frequency_Hz, p_.bandpass_bandwidth_Hz, 1.0 / p_.ts_s);
   demod_.configure(p_.demod_lowpass_s, p_.ts_s);
   pll_.configure(p_.pll_bandwidth_Hz);
-  wn_own_ = 2.0 * kPi * p_.pll_bandwidth_Hz;
-  id_f_.configure(p_.stiffness_current_filter_s, p_.ts_s);
-  iq_f_.configure(p_.stiffness_current_filter_s, p_.ts_s);
 }
 
 void Hfi::update(const EstimatorInput& in) {
@@ -31,11 +29,8 @@ void Hfi::update(const EstimatorInput& in) {
   const double iq = -s * in.ialpha_A + c * in.ibeta_A;
   const double hf_d = bp_d_.update(id);
   const double hf_q = bp_q_.update(iq);
-  if (stiffness_.enabled()) {
-    // Every 1 ms: the PLL must outrun the shaft's angle-error growth at this operating point.
-    const double idf = id_f_.update(id - hf_d), iqf = iq_f_.update(iq - hf_q);
-    if (step_ % 10 == 0) pll_.set_natural_frequency(stiffness_.bandwidth_rad_s(wn_own_, idf, iqf));
-  }
+  // The PLL must outrun the shaft's angle-error growth at this operating point.
+  tuner_.update(pll_, id - hf_d, iq - hf_q);
   // The current integrates the cosine carrier: its response is a sine, delayed with the command.
   const double ref = std::sin(w_hf_ * static_cast<double>(step_) * p_.ts_s - delay_rad_);
   const double eps = demod_.update(2.0 * hf_q * ref);

@@ -46,9 +46,7 @@ class Hfi final : public Estimator {
   BandPass bp_d_, bp_q_;
   LowPass demod_;
   TrackingObserver pll_;
-  ShaftStiffness stiffness_;
-  LowPass id_f_, iq_f_;
-  double wn_own_ = 0;
+  StiffnessTuner tuner_;
 };
 
 }  // namespace synbench::emulator::firmware

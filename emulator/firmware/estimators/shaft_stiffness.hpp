@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "emulator/firmware/estimators/tracking_observer.hpp"
+#include "emulator/firmware/pi.hpp"
 #include "emulator/flux_map.hpp"
 #include "emulator/twin_config.hpp"
 
@@ -55,6 +57,34 @@ class ShaftStiffness {
 
   ShaftStiffnessParams p_;
   FluxAxis d_, q_;
+};
+
+// Retunes a tracking observer (HFI's PLL, the EEMF observer) to the operating point: every 1 ms
+// its natural frequency becomes ShaftStiffness::bandwidth_rad_s at the observer-frame currents,
+// smoothed over `current_filter_s` so that current noise does not modulate the loop.
+class StiffnessTuner {
+ public:
+  StiffnessTuner(const ShaftStiffnessParams& p, double own_bandwidth_Hz, double current_filter_s,
+                 double ts_s)
+      : stiffness_(p), wn_own_(2.0 * 3.14159265358979323846 * own_bandwidth_Hz),
+        every_(std::max(1L, std::lround(1e-3 / ts_s))) {
+    id_f_.configure(current_filter_s, ts_s);
+    iq_f_.configure(current_filter_s, ts_s);
+  }
+
+  // Once per sample, with the currents in the observer's frame.
+  void update(TrackingObserver& observer, double id_A, double iq_A) {
+    if (!stiffness_.enabled()) return;
+    const double idf = id_f_.update(id_A), iqf = iq_f_.update(iq_A);
+    if (step_++ % every_ == 0)
+      observer.set_natural_frequency(stiffness_.bandwidth_rad_s(wn_own_, idf, iqf));
+  }
+
+ private:
+  ShaftStiffness stiffness_;
+  LowPass id_f_, iq_f_;
+  double wn_own_;
+  long every_, step_ = 0;
 };
 
 }  // namespace synbench::emulator::firmware
