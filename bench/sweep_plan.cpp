@@ -199,6 +199,16 @@ PointOptions point_options(const SweepPlan& plan) {
   return o;
 }
 
+SafetyLimits safety_limits(const SweepPlan& plan) {
+  SafetyLimits l;
+  l.max_speed_rpm = plan.limits.max_speed_rpm;
+  l.max_current_A = plan.limits.max_current_A;
+  l.max_udc_V = plan.limits.max_udc_V;
+  l.min_udc_V = plan.limits.min_udc_V;
+  l.max_temp_C = plan.limits.max_temp_C;
+  return l;
+}
+
 ojson to_json(const SweepPlan& p) {
   ojson j = ojson::object();
   j["name"] = p.name;

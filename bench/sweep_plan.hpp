@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/point_procedure.hpp"
+#include "bench/safety_supervisor.hpp"
 #include "bench/steady_state.hpp"
 #include "bench/sweep_plan_angle_search.hpp"
 #include "bench/sweep_plan_configuration.hpp"
@@ -147,6 +148,9 @@ PlannedPoint adaptive_point(const SweepPlan& plan, const PlannedGroup& group, st
 
 // The point procedure's options for this plan's gate (other fields keep PointOptions' defaults).
 PointOptions point_options(const SweepPlan& plan);
+
+// The safety supervisor's limits from the plan's (those SafetyLimits has).
+SafetyLimits safety_limits(const SweepPlan& plan);
 
 // Bench-time model (docs/sweep-plan.md): per point, settling (the larger of the gate's
 // min_settle_s and span_s, plus settle_extra_s) and the window; ramps for every speed and load

@@ -125,16 +125,6 @@ bool write_file(const std::string& path, const std::string& text) {
   return static_cast<bool>(out);
 }
 
-bench::SafetyLimits limits_of(const bench::SweepPlan& plan) {
-  bench::SafetyLimits l;
-  l.max_speed_rpm = plan.limits.max_speed_rpm;
-  l.max_current_A = plan.limits.max_current_A;
-  l.max_udc_V = plan.limits.max_udc_V;
-  l.min_udc_V = plan.limits.min_udc_V;
-  l.max_temp_C = plan.limits.max_temp_C;
-  return l;
-}
-
 }  // namespace
 
 int sweep_command(const std::vector<std::string>& argv) {
@@ -240,7 +230,7 @@ int sweep_command(const std::vector<std::string>& argv) {
   (void)store.set_sweep_state(id, db::SweepState::running);
 
   emulator::TwinBench twin(config);
-  bench::SafetySupervisor supervisor(twin.devices(), limits_of(*plan), [&](const std::string& k, const std::string& m) {
+  bench::SafetySupervisor supervisor(twin.devices(), bench::safety_limits(*plan), [&](const std::string& k, const std::string& m) {
     (void)store.add_event(id, k == "fault" ? db::EventKind::fault : db::EventKind::state, m);
   });
   StoreSink sink(store, id, quiet, print_committed);

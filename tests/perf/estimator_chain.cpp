@@ -1,14 +1,16 @@
-// Benchmark: one sensorless configuration through the thesis grid chained as a sweep runs it
-// (bench/sweep_engine: one twin, the drives kept running, speed > load > angle, the gate deciding
-// when a point has settled). A fresh twin per point (estimator_grid) hides what a sweep meets:
-// the observer must carry its lock through every setpoint change. Prints per-speed counts of
-// faults, points flagged unstable and points out of lock (position-error span over 90 deg: a
-// slipping observer sweeps the whole (-90, 90] deg), the worst |mean position error| in lock, the
-// mean settling time and the wall time. Exits 1 when a point faults.
+// Benchmark: one sensorless configuration through the thesis grid as `synbench sweep` runs it:
+// bench::SweepEngine on one in-process twin (the drives kept running, speed > load > angle, the
+// gate deciding when a point has settled, the thermal precondition, the restart after a lost
+// speed), with the records kept in memory instead of SQLite. A fresh twin per point
+// (estimator_grid) hides what a sweep meets: the observer must carry its lock through every
+// setpoint change. Prints per-speed counts of points, points flagged unstable and points out of
+// lock (position-error span over 90 deg: a slipping observer sweeps the whole (-90, 90] deg), the
+// worst |mean position error| in lock, the mean settling time, the restarts, the sweep's end
+// state and the wall time. Exits 1 when the sweep does not complete.
 // usage: estimator_chain --estimator NAME [--pwm capwm|aspwm] [--speeds a,b,..] [--loads ..]
 //                        [--angles ..] [--timeout-s S] [--config FILE] [--verbose]
-//   defaults: the thesis grid (EEMF variants from 500 rpm), the thesis PWM of the estimator,
-//   the gate timeout of bench::PointOptions.
+//   defaults: the thesis-grid preset (EEMF variants from 500 rpm, HFI up to 300 rpm), the thesis
+//   PWM of the estimator, the plan's gate timeout.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,7 +21,11 @@
 #include <string>
 #include <vector>
 
-#include "bench/point_procedure.hpp"
+#include <nlohmann/json.hpp>
+
+#include "bench/safety_supervisor.hpp"
+#include "bench/sweep_engine.hpp"
+#include "bench/sweep_plan.hpp"
 #include "emulator/twin_bench.hpp"
 #include "emulator/twin_config_schema.hpp"
 
@@ -27,12 +33,6 @@ namespace {
 
 using synbench::drivers::Estimator;
 using synbench::drivers::Pwm;
-
-std::vector<double> range(double from, double to, double step) {
-  std::vector<double> v;
-  for (int k = 0; from + k * step <= to + 1e-9; ++k) v.push_back(from + k * step);
-  return v;
-}
 
 std::vector<double> list(const char* s) {
   std::vector<double> v;
@@ -44,27 +44,29 @@ std::vector<double> list(const char* s) {
 }
 
 struct Tally {
-  int points = 0, faults = 0, unstable = 0, out_of_lock = 0, restarts = 0;
+  int points = 0, unstable = 0, out_of_lock = 0;
   double worst_in_lock_deg = 0, settle_sum_s = 0;
 };
 
-// What bench::SweepEngine does after a lost point: load torque to zero, then disable (the
-// shaft coasts; a drive that lost the rotor is not asked to decelerate it).
-void ordered_stop(synbench::emulator::TwinBench& bench) {
-  auto dev = bench.devices();
-  auto& clock = bench.clock();
-  dev.load->set_torque_Nm(0.0);
-  clock.wait_until(clock.now_s() + 1.0);
-  dev.synrm->enable(false);
-  dev.load->enable(false);
-}
+struct RecordSink : synbench::bench::SweepSink {
+  std::vector<synbench::bench::PointRecord> records;
+  int restarts = 0;
+  std::error_code store_point(std::size_t, const synbench::bench::PointRecord& r) override {
+    records.push_back(r);
+    return {};
+  }
+  void event(const std::string& kind, const std::string& message) override {
+    // The engine logs each point whose speed was lost before it restarts the drives.
+    if (kind == "log" && message.find("restarting the drives") != std::string::npos) ++restarts;
+  }
+};
 
 }  // namespace
 
 int main(int argc, char** argv) {
   Estimator e = Estimator::encoder;  // encoder: none given (or a bad argument)
   std::optional<Pwm> pwm;
-  std::vector<double> speeds, loads = range(0.5, 3.5, 0.5), angles = range(40, 76, 2);
+  std::vector<double> speeds, loads, angles;
   std::optional<double> timeout_s;
   const char* config_path = nullptr;
   bool verbose = false;
@@ -100,9 +102,7 @@ int main(int argc, char** argv) {
                  argv[0]);
     return 2;
   }
-  const bool eemf = e == Estimator::eemf_const || e == Estimator::eemf_lut || e == Estimator::eemf_rls;
   const bool ekf = e == Estimator::ekf_basic || e == Estimator::ekf_rs;
-  if (speeds.empty()) speeds = eemf ? range(500, 900, 200) : range(100, 900, 200);
   if (!pwm) pwm = ekf ? Pwm::aspwm : Pwm::capwm;
 
   synbench::emulator::TwinConfig cfg;
@@ -112,70 +112,64 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", ex.what());
     return 2;
   }
+  // The thesis-grid preset with this one configuration; the dimensions given replace the
+  // preset's, as in a plan file.
+  nlohmann::json doc = {{"name", "estimator chain"},
+                        {"preset", "thesis-grid"},
+                        {"dimensions",
+                         {{"configurations",
+                           {{{"estimator", synbench::drivers::name(e)}, {"pwm", synbench::drivers::name(*pwm)}}}}}}};
+  if (!speeds.empty()) doc["dimensions"]["speed_rpm"] = speeds;
+  if (!loads.empty()) doc["dimensions"]["load_Nm"] = loads;
+  if (!angles.empty()) doc["dimensions"]["angle_deg"] = angles;
+  if (timeout_s) doc["gate"]["timeout_s"] = *timeout_s;
+  auto parsed = synbench::bench::parse_sweep_plan(doc);
+  if (!parsed.errors.empty()) {
+    std::fprintf(stderr, "plan: %s\n", to_string(parsed.errors.front()).c_str());
+    return 2;
+  }
   synbench::emulator::TwinBench bench(cfg);
-  synbench::bench::PointOptions opt;
-  opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
-  opt.ordered_stop_after = false;
-  opt.continue_running = true;
-  if (timeout_s) opt.settle_timeout_s = *timeout_s;
+  synbench::bench::SafetySupervisor supervisor(bench.devices(), synbench::bench::safety_limits(*parsed.plan));
+  RecordSink sink;
+  synbench::bench::SweepBench sweep_bench;
+  sweep_bench.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
+  synbench::bench::SweepEngine engine(bench.devices(), supervisor, *parsed.plan, {}, sink, sweep_bench);
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::map<double, Tally> by_speed;
-  Tally all;
-  bool faulted = false;
-  for (double speed : speeds) {
-    for (double load : loads) {
-      for (double angle : angles) {
-        const synbench::bench::PointRequest req{
-            .speed_rpm = speed, .load_Nm = load, .angle_deg = angle, .estimator = e, .pwm = *pwm};
-        const auto proc = synbench::bench::run_point(bench.devices(), bench.clock(), req, opt);
-        const auto& r = proc.record();
-        // As the sweep engine does: a drive that lost the speed is stopped in order and the next
-        // point starts from standstill.
-        if (proc.speed_lost()) {
-          ++all.restarts;
-          ordered_stop(bench);
-        }
-        Tally& t = by_speed[speed];
-        for (Tally* x : {&t, &all}) {
-          ++x->points;
-          x->settle_sum_s += r.settle_s;
-          if (r.fault) {
-            ++x->faults;
-            continue;
-          }
-          x->unstable += r.unstable ? 1 : 0;
-          if (!r.pos_err_mean_deg) continue;
-          const bool lost = *r.pos_err_max_deg - *r.pos_err_min_deg > 90.0;
-          x->out_of_lock += lost ? 1 : 0;
-          if (!lost)
-            x->worst_in_lock_deg = std::max(x->worst_in_lock_deg, std::fabs(*r.pos_err_mean_deg));
-        }
-        if (verbose || r.fault)
-          std::printf("%g rpm %g N m %g deg: %s pos %+.2f [%+.1f, %+.1f] deg, speed %.1f rpm, "
-                      "settle %.1f s%s\n",
-                      speed, load, angle, r.fault ? r.fault->c_str() : "ok",
-                      r.pos_err_mean_deg.value_or(NAN), r.pos_err_min_deg.value_or(NAN),
-                      r.pos_err_max_deg.value_or(NAN), r.speed_meas_rpm, r.settle_s,
-                      r.unstable ? " UNSTABLE" : "");
-        if (r.fault) {
-          faulted = true;
-          break;
-        }
-      }
-      if (faulted) break;
-    }
-    if (faulted) break;
+  // As `synbench sweep` on the in-process twin: supervisor, then engine, every 10 ms.
+  for (double t = 0; !engine.finished();) {
+    t += 0.01;
+    bench.clock().wait_until(t);
+    supervisor.tick(t);
+    engine.tick(t);
   }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::map<double, Tally> by_speed;
+  Tally all;
+  for (const auto& r : sink.records) {
+    for (Tally* x : {&by_speed[r.speed_rpm], &all}) {
+      ++x->points;
+      x->settle_sum_s += r.settle_s;
+      x->unstable += r.unstable ? 1 : 0;
+      if (!r.pos_err_mean_deg) continue;
+      const bool lost = *r.pos_err_max_deg - *r.pos_err_min_deg > 90.0;
+      x->out_of_lock += lost ? 1 : 0;
+      if (!lost) x->worst_in_lock_deg = std::max(x->worst_in_lock_deg, std::fabs(*r.pos_err_mean_deg));
+    }
+    if (verbose)
+      std::printf("%g rpm %g N m %g deg: pos %+.2f [%+.1f, %+.1f] deg, speed %.1f rpm, settle %.1f s%s\n",
+                  r.speed_rpm, r.load_Nm, r.angle_deg, r.pos_err_mean_deg.value_or(NAN),
+                  r.pos_err_min_deg.value_or(NAN), r.pos_err_max_deg.value_or(NAN), r.speed_meas_rpm,
+                  r.settle_s, r.unstable ? " UNSTABLE" : "");
+  }
   auto print = [](const char* what, const Tally& t) {
-    std::printf("%-8s %4d points, %d faulted, %3d unstable, %3d out of lock, worst |mean| in lock "
+    std::printf("%-8s %4d points, %3d unstable, %3d out of lock, worst |mean| in lock "
                 "%5.2f deg, mean settle %.1f s\n",
-                what, t.points, t.faults, t.unstable, t.out_of_lock, t.worst_in_lock_deg,
+                what, t.points, t.unstable, t.out_of_lock, t.worst_in_lock_deg,
                 t.points ? t.settle_sum_s / t.points : 0.0);
   };
-  std::printf("%s / %s, chained\n", std::string(synbench::drivers::name(e)).c_str(),
+  std::printf("%s / %s, as a sweep\n", std::string(synbench::drivers::name(e)).c_str(),
               std::string(synbench::drivers::name(*pwm)).c_str());
   for (const auto& [speed, t] : by_speed) {
     char what[32];
@@ -183,7 +177,11 @@ int main(int argc, char** argv) {
     print(what, t);
   }
   print("all", all);
-  std::printf("restarts after a lost speed: %d\n", all.restarts);
+  std::printf("restarts after a lost speed: %d\n", sink.restarts);
+  const bool completed = engine.state() == synbench::bench::SweepState::completed;
+  std::printf("sweep %s after %zu of %zu points%s%s\n",
+              std::string(synbench::bench::name(engine.state())).c_str(), sink.records.size(),
+              engine.progress().total, completed ? "" : ": ", completed ? "" : engine.error().c_str());
   std::printf("wall %.1f s\n", wall_s);
-  return faulted ? 1 : 0;
+  return completed ? 0 : 1;
 }
