@@ -7,7 +7,20 @@
 namespace synbench::bench {
 
 void SteadyStateGate::add(double t_s, double speed_rpm, double im_A, double power_W) {
-  samples_.push_back({t_s, {speed_rpm, im_A, power_W}});
+  Sample s{t_s, {speed_rpm, im_A, power_W}};
+  if (b_.average_s > 0) {
+    raw_.push_back(s);
+    for (int k = 0; k < 3; ++k) sum_[k] += s.v[k];
+    while (raw_.size() > 1 && raw_.front().t < t_s - b_.average_s) {
+      for (int k = 0; k < 3; ++k) sum_[k] -= raw_.front().v[k];
+      raw_.pop_front();
+    }
+    // A mean over less than its time is not one yet.
+    if (t_s - raw_.front().t < 0.9 * b_.average_s) return;
+    const double n = static_cast<double>(raw_.size());
+    for (int k = 0; k < 3; ++k) s.v[k] = sum_[k] / n;
+  }
+  samples_.push_back(s);
   while (samples_.size() > 2 && samples_.front().t < t_s - b_.span_s) samples_.pop_front();
 }
 

@@ -107,17 +107,11 @@ ojson configuration_json(const PlannedConfiguration& c) {
   j["pwm"] = std::string(drivers::name(c.configuration.pwm));
   j["min_speed_rpm"] = c.min_speed_rpm;
   j["max_speed_rpm"] = c.max_speed_rpm ? ojson(*c.max_speed_rpm) : ojson(nullptr);
+  j["gate_average_s"] = c.gate_average_s ? ojson(*c.gate_average_s) : ojson(nullptr);
   return j;
 }
 
 }  // namespace
-
-bool GateOptions::operator==(const GateOptions& o) const {
-  return bands.span_s == o.bands.span_s && bands.speed_band_rpm == o.bands.speed_band_rpm &&
-         bands.im_band_rel == o.bands.im_band_rel && bands.im_band_min_A == o.bands.im_band_min_A &&
-         bands.power_band_rel == o.bands.power_band_rel && bands.power_band_min_W == o.bands.power_band_min_W &&
-         min_settle_s == o.min_settle_s && timeout_s == o.timeout_s;
-}
 
 std::vector<double> inclusive_range(double from, double to, double step) {
   std::vector<double> out;
@@ -199,6 +193,13 @@ PointOptions point_options(const SweepPlan& plan) {
   return o;
 }
 
+PointOptions point_options(const SweepPlan& plan, const Configuration& c) {
+  PointOptions o = point_options(plan);
+  for (const auto& pc : plan.configurations)
+    if (pc.configuration == c && pc.gate_average_s) o.gate.average_s = *pc.gate_average_s;
+  return o;
+}
+
 SafetyLimits safety_limits(const SweepPlan& plan) {
   SafetyLimits l;
   l.max_speed_rpm = plan.limits.max_speed_rpm;
@@ -250,6 +251,7 @@ ojson to_json(const SweepPlan& p) {
                {"im_band_min_A", g.bands.im_band_min_A},
                {"power_band_rel", g.bands.power_band_rel},
                {"power_band_min_W", g.bands.power_band_min_W},
+               {"average_s", g.bands.average_s},
                {"min_settle_s", g.min_settle_s},
                {"timeout_s", g.timeout_s}};
   j["window_s"] = p.window_s;
@@ -287,8 +289,11 @@ SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& m) {
         steps.push_back({g.speed_rpm, g.load_Nm, g.configuration.configuration});
   }
   e.points = steps.size();
-  const double per_point_s =
-      std::max(plan.gate.min_settle_s, plan.gate.bands.span_s) + m.settle_extra_s + plan.window_s;
+  // The gate needs its span of (averaged) samples before it can pass.
+  auto per_point_s = [&](const Configuration& c) {
+    const double gate_s = plan.gate.bands.span_s + point_options(plan, c).gate.average_s;
+    return std::max(plan.gate.min_settle_s, gate_s) + m.settle_extra_s + plan.window_s;
+  };
   double speed = 0, load = 0, t = 0;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const auto& s = steps[i];
@@ -302,7 +307,7 @@ SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& m) {
     }
     t += std::fabs(s.speed_rpm - speed) / m.speed_ramp_rpm_per_s;
     t += std::fabs(s.load_Nm - load) / m.load_ramp_Nm_per_s;
-    t += per_point_s;
+    t += per_point_s(s.config);
     speed = s.speed_rpm;
     load = s.load_Nm;
   }

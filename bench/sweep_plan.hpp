@@ -27,6 +27,7 @@ struct PlannedConfiguration {
   Configuration configuration;
   double min_speed_rpm = 0;
   std::optional<double> max_speed_rpm;  // none: no upper restriction
+  std::optional<double> gate_average_s;  // replaces the plan's gate.average_s for these points
   bool operator==(const PlannedConfiguration&) const = default;
 };
 
@@ -49,7 +50,7 @@ struct GateOptions {
   SteadyStateBands bands;
   double min_settle_s = 0.5;
   double timeout_s = 30.0;
-  bool operator==(const GateOptions& o) const;
+  bool operator==(const GateOptions&) const = default;
 };
 
 // Thermal precondition: measure only with the winding within target_C +/- band_C. Below it the
@@ -146,8 +147,10 @@ std::vector<PlannedPoint> expand(const SweepPlan& plan);
 PlannedPoint adaptive_point(const SweepPlan& plan, const PlannedGroup& group, std::size_t evaluation,
                             double angle_deg);
 
-// The point procedure's options for this plan's gate (other fields keep PointOptions' defaults).
+// The point procedure's options for this plan's gate (other fields keep PointOptions' defaults);
+// with a configuration, its gate_average_s replaces the plan's where it has one.
 PointOptions point_options(const SweepPlan& plan);
+PointOptions point_options(const SweepPlan& plan, const Configuration& c);
 
 // The safety supervisor's limits from the plan's (those SafetyLimits has).
 SafetyLimits safety_limits(const SweepPlan& plan);

@@ -303,7 +303,7 @@ void parse_configurations(Parser& p, const json& v, const std::string& ptr, bool
     }
     const json& c = v[i];
     const std::size_t before = p.errors.size();
-    p.reject_unknown(c, cp, {"estimator", "pwm", "min_speed_rpm", "max_speed_rpm"});
+    p.reject_unknown(c, cp, {"estimator", "pwm", "min_speed_rpm", "max_speed_rpm", "gate_average_s"});
     PlannedConfiguration pc;
     const auto est = p.string(c, cp, "estimator");
     const auto pwm = p.string(c, cp, "pwm");
@@ -317,10 +317,14 @@ void parse_configurations(Parser& p, const json& v, const std::string& ptr, bool
       if (auto w = drivers::parse_pwm(*pwm)) pc.configuration.pwm = *w;
       else p.fail(cp + "/pwm", "unknown PWM scheme " + in_quotes(*pwm) + " (expected " + pwm_list() + ")");
     }
-    if (thesis_rules) pc = PlannedConfiguration{with_thesis_speed_range(pc.configuration)};
+    if (thesis_rules) pc = with_thesis_defaults(pc.configuration);
     p.set(c, cp, "min_speed_rpm", pc.min_speed_rpm, non_negative());
     if (const auto it = c.find("max_speed_rpm"); it != c.end() && !it->is_null()) {
       if (auto x = p.number_value(*it, cp + "/max_speed_rpm", positive())) pc.max_speed_rpm = *x;
+    }
+    if (const auto it = c.find("gate_average_s"); it != c.end()) {
+      if (it->is_null()) pc.gate_average_s.reset();
+      else if (auto x = p.number_value(*it, cp + "/gate_average_s", non_negative())) pc.gate_average_s = *x;
     }
     if (pc.max_speed_rpm && *pc.max_speed_rpm < pc.min_speed_rpm)
       p.fail(cp + "/max_speed_rpm", "must be >= min_speed_rpm (" + num(pc.min_speed_rpm) + ")");
@@ -481,7 +485,7 @@ void parse_gate(Parser& p, const json& doc, GateOptions& g) {
   if (!p.object(*it, ptr)) return;
   const json& v = *it;
   p.reject_unknown(v, ptr, {"span_s", "speed_band_rpm", "im_band_rel", "im_band_min_A", "power_band_rel",
-                            "power_band_min_W", "min_settle_s", "timeout_s"});
+                            "power_band_min_W", "average_s", "min_settle_s", "timeout_s"});
   // The band floors must be > 0: a zero band is never met by a measured signal.
   p.set(v, ptr, "span_s", g.bands.span_s, positive());
   p.set(v, ptr, "speed_band_rpm", g.bands.speed_band_rpm, positive());
@@ -489,6 +493,7 @@ void parse_gate(Parser& p, const json& doc, GateOptions& g) {
   p.set(v, ptr, "im_band_min_A", g.bands.im_band_min_A, positive());
   p.set(v, ptr, "power_band_rel", g.bands.power_band_rel, non_negative());
   p.set(v, ptr, "power_band_min_W", g.bands.power_band_min_W, positive());
+  p.set(v, ptr, "average_s", g.bands.average_s, non_negative());
   p.set(v, ptr, "min_settle_s", g.min_settle_s, non_negative());
   p.set(v, ptr, "timeout_s", g.timeout_s, positive());
   if (g.timeout_s <= g.min_settle_s)

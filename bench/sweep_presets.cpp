@@ -27,10 +27,12 @@ std::string rpm(double v) {
 
 }  // namespace
 
-PlannedConfiguration with_thesis_speed_range(Configuration c) {
-  PlannedConfiguration p{c, 0, std::nullopt};
+PlannedConfiguration with_thesis_defaults(Configuration c) {
+  PlannedConfiguration p{c, 0, std::nullopt, std::nullopt};
   if (is_eemf(c.estimator)) p.min_speed_rpm = kThesisEemfMinSpeed_rpm;
   if (c.estimator == Estimator::hfi) p.max_speed_rpm = kThesisHfiMaxSpeed_rpm;
+  if (c.estimator == Estimator::hfi || c.estimator == Estimator::eemf_rls)
+    p.gate_average_s = kThesisInjectionGateAverage_s;
   return p;
 }
 
@@ -42,7 +44,7 @@ std::vector<PlannedConfiguration> thesis_configurations() {
       {Estimator::eemf_lut, Pwm::capwm},   {Estimator::eemf_rls, Pwm::capwm},
   };
   std::vector<PlannedConfiguration> out;
-  for (const auto& c : list) out.push_back(with_thesis_speed_range(c));
+  for (const auto& c : list) out.push_back(with_thesis_defaults(c));
   return out;
 }
 
@@ -69,7 +71,7 @@ SweepPlan iec_61800_9_2_plan(const IecPresetOptions& o) {
   p.name = std::string(kIecPreset);
   p.preset = std::string(kIecPreset);
   p.angles_deg = inclusive_range(kThesisAngleFrom_deg, kThesisAngleTo_deg, kThesisAngleStep_deg);
-  p.configurations = {PlannedConfiguration{kReferenceConfiguration, 0, std::nullopt}};
+  p.configurations = {PlannedConfiguration{kReferenceConfiguration, 0, std::nullopt, std::nullopt}};
   p.adaptive.from_deg = kThesisAngleFrom_deg;
   p.adaptive.to_deg = kThesisAngleTo_deg;
   bool zero_noted = false;

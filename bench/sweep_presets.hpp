@@ -28,14 +28,19 @@ inline constexpr double kThesisEemfMinSpeed_rpm = 500;
 // 100 and 300 rpm, where the EEMF variants hand over to it). [assumed] upper end of the range:
 // above it the twin's HFI loses lock at every point (docs/estimators.md).
 inline constexpr double kThesisHfiMaxSpeed_rpm = 300;
+// [assumed] The injecting configurations (HFI's carrier, EEMF-RLS's PRBS) make speed, I_m and
+// P_dcM fluctuate by design; their gate judges trailing means over this time: four periods of
+// the 5-bit PRBS at 10 ms per bit (31 bits, 0.31 s), and several of HFI's 4..5 Hz speed wobble.
+inline constexpr double kThesisInjectionGateAverage_s = 1.24;
 
 // The eight configurations of the thesis (physics.md Sec. 8): encoder with CAPWM (the reference)
 // and ASPWM, EKF-BASIC and EKF-RS with ASPWM, HFI and the three EEMF variants with CAPWM; the
 // EEMF variants restricted to >= 500 rpm.
 std::vector<PlannedConfiguration> thesis_configurations();
-// The thesis restriction applied to a configuration a plan lists with the thesis-grid preset:
-// EEMF variants get min_speed_rpm = 500, HFI max_speed_rpm = 300, unless the plan sets them.
-PlannedConfiguration with_thesis_speed_range(Configuration c);
+// The thesis defaults applied to a configuration a plan lists with the thesis-grid preset:
+// EEMF variants get min_speed_rpm = 500, HFI max_speed_rpm = 300, HFI and EEMF-RLS
+// gate_average_s = kThesisInjectionGateAverage_s, unless the plan sets them.
+PlannedConfiguration with_thesis_defaults(Configuration c);
 
 SweepPlan thesis_grid_plan();
 

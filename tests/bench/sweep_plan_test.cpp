@@ -292,6 +292,10 @@ INSTANTIATE_TEST_SUITE_P(
                                            {"speed_rpm": 100}]}})",
                   {"/dimensions/operating_points/1/speed_rpm", "/dimensions/operating_points/2/load_Nm"}},
         ErrorCase{R"({"preset": "thesis"})", {"/preset"}},
+        ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50],
+                      "configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": -1}]},
+                      "gate": {"average_s": "long"}})",
+                  {"/dimensions/configurations/0/gate_average_s", "/gate/average_s"}},
         ErrorCase{R"({"preset": {"name": "iec-61800-9-2", "rated_speed_rpm": -1, "zero": 1}})",
                   {"/preset/zero", "/preset/rated_speed_rpm"}},
         ErrorCase{R"({"preset": "iec-61800-9-2", "dimensions": {"speed_rpm": [100]}})", {"/dimensions/speed_rpm"}},
@@ -465,6 +469,33 @@ TEST(SweepPresets, ThesisGrid) {
     }
   }
   EXPECT_EQ(plan_groups(p).size(), 4u * 35u + 14u + 3u * 21u);
+}
+
+// The injecting configurations' gate judges trailing means (docs/sweep-plan.md); a plan can
+// change or remove that per configuration, and the plan-wide gate has the same key.
+TEST(SweepPresets, ThesisGridAveragesTheGateOfTheInjectingConfigurations) {
+  const auto p = parse_ok(json{{"preset", "thesis-grid"}});
+  for (const auto& c : p.configurations) {
+    const bool injects = c.configuration.estimator == Estimator::hfi || c.configuration.estimator == Estimator::eemf_rls;
+    EXPECT_EQ(c.gate_average_s, injects ? std::optional<double>(1.24) : std::nullopt) << label(c.configuration);
+    EXPECT_EQ(point_options(p, c.configuration).gate.average_s, injects ? 1.24 : 0.0) << label(c.configuration);
+  }
+  const auto q = parse_ok(json::parse(R"({"preset": "thesis-grid", "gate": {"average_s": 0.2},
+    "dimensions": {"configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": null},
+                                      {"estimator": "eemf-rls", "pwm": "capwm", "gate_average_s": 2},
+                                      {"estimator": "encoder", "pwm": "capwm"}]}})"));
+  EXPECT_EQ(point_options(q, {Estimator::hfi, Pwm::capwm}).gate.average_s, 0.2);
+  EXPECT_EQ(point_options(q, {Estimator::eemf_rls, Pwm::capwm}).gate.average_s, 2.0);
+  EXPECT_EQ(point_options(q, {Estimator::encoder, Pwm::capwm}).gate.average_s, 0.2);
+  EXPECT_EQ(parse_ok(to_json(q)), q);
+  // Outside the thesis preset nothing is averaged unless asked.
+  const auto r = parse_ok(json::parse(R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50],
+    "configurations": [{"estimator": "hfi", "pwm": "capwm"}]}})"));
+  EXPECT_EQ(point_options(r, {Estimator::hfi, Pwm::capwm}).gate.average_s, 0.0);
+  // Each averaged point waits for its mean before the span: 1.24 s more per point.
+  const auto s = parse_ok(json::parse(R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50, 52],
+    "configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": 1.24}]}})"));
+  EXPECT_NEAR(estimate(s).bench_time_s - estimate(r).bench_time_s, 2 * 1.24 + 2.5, 1e-9);
 }
 
 TEST(SweepPresets, ThesisGridWith23AnglesGives805PerConfiguration) {

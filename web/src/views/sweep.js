@@ -147,8 +147,9 @@ export class SweepView {
       <button type="button" class="small" aria-label="Remove configuration ${n}">Remove</button>`;
     row.dataset.min = c.min_speed_rpm ?? '';
     row.dataset.max = c.max_speed_rpm ?? '';
+    row.dataset.avg = c.gate_average_s ?? '';
     row.querySelector('button').addEventListener('click', () => { row.remove(); this.changed(); });
-    row.querySelector('[data-role="est"]').addEventListener('change', () => { row.dataset.min = ''; row.dataset.max = ''; });
+    row.querySelector('[data-role="est"]').addEventListener('change', () => { row.dataset.min = ''; row.dataset.max = ''; row.dataset.avg = ''; });
     $('#b-configs').append(row);
   }
 
@@ -223,6 +224,7 @@ export class SweepView {
       const c = { estimator: row.querySelector('[data-role="est"]').value, pwm: row.querySelector('[data-role="pwm"]').value };
       if (row.dataset.min !== '') c.min_speed_rpm = Number(row.dataset.min);
       if (row.dataset.max !== '' && row.dataset.max !== 'null') c.max_speed_rpm = Number(row.dataset.max);
+      if (row.dataset.avg !== '' && row.dataset.avg !== 'null') c.gate_average_s = Number(row.dataset.avg);
       return c;
     });
     plan.dimensions = dims;
