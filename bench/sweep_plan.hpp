@@ -156,7 +156,7 @@ PointOptions point_options(const SweepPlan& plan, const Configuration& c);
 SafetyLimits safety_limits(const SweepPlan& plan);
 
 // Bench-time model (docs/sweep-plan.md): per point, settling (the larger of the gate's
-// min_settle_s and span_s, plus settle_extra_s) and the window; ramps for every speed and load
+// min_settle_s and span_s + the configuration's average_s, plus settle_extra_s) and the window; ramps for every speed and load
 // change (from and back to standstill at the ends); a fixed cost per configuration change (the
 // engine stops and restarts the drive to switch estimator or PWM). Thermal waits are not
 // included: they depend on the machine's state.

@@ -564,9 +564,28 @@ void check_coverage(Parser& p, const json& doc, const SweepPlan& plan) {
   }
   if (!p.errors.empty()) return;
 
+  // A gate that needs its timeout's worth of samples can never pass: every point unstable.
+  const auto& gate = plan.gate;
+  if (gate.bands.average_s + gate.bands.span_s >= gate.timeout_s)
+    p.fail("/gate/average_s", num(gate.bands.average_s) + " + span_s (" + num(gate.bands.span_s) +
+                                  ") must stay below timeout_s (" + num(gate.timeout_s) + ")");
+  const bool listed = from_doc("configurations");
+  for (std::size_t i = 0; i < plan.configurations.size(); ++i) {
+    const auto& c = plan.configurations[i];
+    if (!c.gate_average_s || *c.gate_average_s + gate.bands.span_s < gate.timeout_s) continue;
+    // A preset's own configurations: the plan's timeout is what the document gave.
+    if (listed)
+      p.fail("/dimensions/configurations/" + std::to_string(i) + "/gate_average_s",
+             num(*c.gate_average_s) + " + /gate/span_s (" + num(gate.bands.span_s) +
+                 ") must stay below /gate/timeout_s (" + num(gate.timeout_s) + ")");
+    else
+      p.fail("/gate/timeout_s", num(gate.timeout_s) + " leaves " + label(c.configuration) +
+                                    " no time: its gate averages over " + num(*c.gate_average_s) + " s");
+  }
+  if (!p.errors.empty()) return;
+
   std::vector<double> speeds = plan.speeds_rpm;
   for (const auto& op : plan.operating_points) speeds.push_back(op.speed_rpm);
-  const bool listed = from_doc("configurations");
   std::size_t pairs_total = 0;
   for (std::size_t i = 0; i < plan.configurations.size(); ++i) {
     const auto& c = plan.configurations[i];

@@ -296,6 +296,16 @@ INSTANTIATE_TEST_SUITE_P(
                       "configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": -1}]},
                       "gate": {"average_s": "long"}})",
                   {"/dimensions/configurations/0/gate_average_s", "/gate/average_s"}},
+        // An average that leaves the gate no time before its timeout.
+        ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50],
+                      "configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": 9.6}]},
+                      "gate": {"timeout_s": 10}})",
+                  {"/dimensions/configurations/0/gate_average_s"}},
+        ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50]},
+                      "gate": {"timeout_s": 2, "average_s": 1.5}})",
+                  {"/gate/average_s"}},
+        // One error per configuration the preset averages (HFI and EEMF-RLS).
+        ErrorCase{R"({"preset": "thesis-grid", "gate": {"timeout_s": 1.6}})", {"/gate/timeout_s", "/gate/timeout_s"}},
         ErrorCase{R"({"preset": {"name": "iec-61800-9-2", "rated_speed_rpm": -1, "zero": 1}})",
                   {"/preset/zero", "/preset/rated_speed_rpm"}},
         ErrorCase{R"({"preset": "iec-61800-9-2", "dimensions": {"speed_rpm": [100]}})", {"/dimensions/speed_rpm"}},
