@@ -122,6 +122,7 @@ struct HfiConfig {
   double frequency_Hz = 500.0;
   double bandpass_bandwidth_Hz = 200.0;  // thesis 25 Hz; docs/estimators.md
   double pll_bandwidth_Hz = 10.0;
+  double align_s = 0.1;  // initial position detection: carrier without torque current
 };
 
 struct EemfConfig {

@@ -161,6 +161,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("estimators.hfi.bandpass_bandwidth_Hz", &h.bandpass_bandwidth_Hz, "assumed",
         "HFI band-pass bandwidth (thesis Sec. 6.2.2: 25 Hz, whose 13 ms envelope lag destabilised the PLL)", A);
   b.pos("estimators.hfi.pll_bandwidth_Hz", &h.pll_bandwidth_Hz, "assumed", "HFI phase-locked loop bandwidth", A);
+  b.num("estimators.hfi.align_s", &h.align_s, 0, 10, "assumed",
+        "HFI initial position detection after each start: the carrier runs this long before the speed loop applies current", A);
   auto& e = c.estimators.eemf;
   b.pos("estimators.eemf.ld_H", &e.ld_H, "Sec. 6.2.3", "EEMF-CONST d inductance");
   b.pos("estimators.eemf.lq_H", &e.lq_H, "Sec. 6.2.3", "EEMF-CONST q inductance");

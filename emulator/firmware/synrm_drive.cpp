@@ -219,8 +219,12 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       std::fabs(speed_ref_rpm_) < kStoppedRpm)
     trip(pending_fault_);
   if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) {
-    // Speed loop at its own rate, on a ramped reference.
-    if (step_ % static_cast<std::uint64_t>(speed_divider_) == 0) {
+    // Speed loop at its own rate, on a ramped reference; held at zero current while the
+    // estimator is still finding the rotor (the reference ramp waits with it).
+    if (estimator_ && estimator_->aligning()) {
+      speed_pi_.reset();
+      im_req_A_ = 0;
+    } else if (step_ % static_cast<std::uint64_t>(speed_divider_) == 0) {
       const double dt = ts_ * speed_divider_;
       const double max_step = cfg_.firmware.speed_ramp_rpm_per_s * dt;
       speed_ref_rpm_ += std::clamp(speed_set_rpm_ - speed_ref_rpm_, -max_step, max_step);

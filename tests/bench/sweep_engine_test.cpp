@@ -171,6 +171,35 @@ namespace {
 // limit gives; on the bench, a sensorless observer that slipped) is recorded unstable at once,
 // logged, and the drives are stopped so that the next point starts from standstill and is
 // measured normally; nothing faults.
+// HFI started after the drives were stopped to switch configuration: the shaft comes to rest at
+// whatever angle the previous configuration left it, and HFI starts from its own zero. Without
+// its initial position detection (the carrier running with no torque current for
+// estimators.hfi.align_s) the first point of this plan started 58 deg off, drove the shaft
+// backwards to -700 rpm and tripped on over-current.
+TEST(SweepEngine, HfiFindsTheRotorAfterAConfigurationSwitch) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(R"({
+    "name": "switch to hfi",
+    "preset": "thesis-grid",
+    "dimensions": {"speed_rpm": [300], "load_Nm": [3.0, 3.5],
+                   "configurations": [{"estimator": "encoder", "pwm": "capwm"}, {"estimator": "hfi", "pwm": "capwm"},
+                                      {"estimator": "encoder", "pwm": "aspwm"}]}
+  })"), {}, sink);
+  run.until(e, 3600);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 2u * 3u * 19u);
+  int hfi = 0;
+  for (const auto& [index, r] : sink.points) {
+    if (r.estimator != drivers::Estimator::hfi) continue;
+    ++hfi;
+    EXPECT_FALSE(r.fault) << index;
+    ASSERT_TRUE(r.pos_err_min_deg && r.pos_err_max_deg) << index;
+    EXPECT_LT(*r.pos_err_max_deg - *r.pos_err_min_deg, 90.0) << index << ": out of lock";
+  }
+  EXPECT_EQ(hfi, 2 * 19);
+}
+
 TEST(SweepEngine, RestartsTheDrivesAfterAPointThatLostTheSpeed) {
   emulator::TwinConfig cfg;
   cfg.firmware.current_limit_A = 1.5;  // about 1.5 N m at most, against a 3.5 N m brake

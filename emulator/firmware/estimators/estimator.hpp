@@ -39,6 +39,10 @@ class Estimator {
   // The currents, in the estimated frame, the current controllers should regulate: an injecting
   // estimator removes its own high-frequency response. Unchanged by default.
   virtual void fundamental(double& /*id_A*/, double& /*iq_A*/) const {}
+  // True while the estimator must find the rotor before the drive may apply torque current
+  // (HFI's initial position detection after an enable): the drive runs the gates and the
+  // injection with the speed loop held at zero current until it ends.
+  virtual bool aligning() const { return false; }
   // True while a low-speed fallback, not this estimator, gives the angle (LowSpeedHandover below
   // its minimum speed): the measurement window counts those samples.
   virtual bool on_fallback() const { return false; }

@@ -31,6 +31,7 @@ std::unique_ptr<Estimator> make_hfi(const TwinConfig& config) {
   p.frequency_Hz = h.frequency_Hz;
   p.bandpass_bandwidth_Hz = h.bandpass_bandwidth_Hz;
   p.pll_bandwidth_Hz = h.pll_bandwidth_Hz;
+  p.align_s = h.align_s;
   p.stiffness = stiffness(config);
   return std::make_unique<Hfi>(p);
 }

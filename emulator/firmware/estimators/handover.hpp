@@ -26,6 +26,7 @@ class LowSpeedHandover final : public Estimator {
   void fundamental(double& id_A, double& iq_A) const override;
   bool main_active() const { return main_active_; }
   bool on_fallback() const override { return !main_active_; }
+  bool aligning() const override { return !main_active_ && fallback_ && fallback_->aligning(); }
 
  private:
   std::unique_ptr<Estimator> main_, fallback_;

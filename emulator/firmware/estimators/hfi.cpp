@@ -9,7 +9,8 @@ constexpr double kPi = 3.14159265358979323846;
 }
 
 Hfi::Hfi(const HfiParams& p)
-    : p_(p), tuner_(p.stiffness, p.pll_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s) {
+    : p_(p), align_steps_(std::lround(p.align_s / p.ts_s)),
+      tuner_(p.stiffness, p.pll_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s) {
   w_hf_ = 2.0 * kPi * p_.frequency_Hz;
   // A command computed now acts over the period after next: its centre is 1.5 periods later.
   delay_rad_ = 1.5 * w_hf_ * p_.ts_s;

@@ -28,6 +28,10 @@ struct HfiParams {
   // Raises the PLL bandwidth where the shaft makes an angle error grow (inertia 0: off).
   ShaftStiffnessParams stiffness;
   double stiffness_current_filter_s = 0.02;  // [assumed] smoothing of the currents it takes
+  // [assumed] Initial position detection: after a start the carrier runs this long with no
+  // torque current, so the PLL finds the rotor before the speed loop turns the shaft with a
+  // wrong angle (a start 50 deg off drove the shaft backwards into an over-current trip).
+  double align_s = 0.1;
 };
 
 class Hfi final : public Estimator {
@@ -37,12 +41,18 @@ class Hfi final : public Estimator {
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
   void fundamental(double& id_A, double& iq_A) const override;
-  void align(double theta_e_rad, double omega_e_rad_s) override { pll_.reset(theta_e_rad, omega_e_rad_s); }
+  // Handed the angle by another source: nothing left to find.
+  void align(double theta_e_rad, double omega_e_rad_s) override {
+    pll_.reset(theta_e_rad, omega_e_rad_s);
+    align_steps_ = 0;
+  }
+  bool aligning() const override { return step_ < align_steps_; }
 
  private:
   HfiParams p_;
   double w_hf_, delay_rad_, gain_A_per_rad_;
   long step_ = 0;
+  long align_steps_;
   BandPass bp_d_, bp_q_;
   LowPass demod_;
   TrackingObserver pll_;
