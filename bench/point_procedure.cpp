@@ -15,7 +15,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 PointProcedure::PointProcedure(drivers::BenchDevices devices, PointRequest request,
                                PointOptions options)
-    : dev_(devices), req_(request), opt_(options), gate_(options.gate) {
+    : dev_(devices), req_(request), opt_(options), gate_(options.gate),
+      load_ramp_(options.load_ramp_Nm_per_s) {
   record_.speed_rpm = req_.speed_rpm;
   record_.load_Nm = req_.load_Nm;
   record_.angle_deg = req_.angle_deg;
@@ -39,7 +40,7 @@ void PointProcedure::begin_stop(double now_s) {
   // Ordered stop, step one: the load first, so the SynRM is never driven by the load. Not
   // ramped by the bench: the load drive ramps it, and a stop must not wait on the bench's ticks.
   dev_.load->set_torque_Nm(0.0);
-  load_cmd_Nm_ = load_target_Nm_ = 0.0;
+  load_ramp_.start(0.0, 0.0);
   load_pending_ = false;
   enter(PointPhase::stop, now_s);
 }
@@ -52,7 +53,7 @@ void PointProcedure::open_window(double now_s) {
 }
 
 void PointProcedure::command_load(double target_Nm) {
-  load_target_Nm_ = target_Nm;
+  load_ramp_.retarget(target_Nm);
   load_pending_ = true;
 }
 
@@ -60,19 +61,9 @@ bool PointProcedure::ramp_load(double now_s) {
   const double dt = t_last_tick_ < 0 ? 0.0 : now_s - t_last_tick_;
   t_last_tick_ = now_s;
   if (!load_pending_) return true;
-  if (opt_.load_ramp_Nm_per_s <= 0) {
-    load_cmd_Nm_ = load_target_Nm_;
-  } else {
-    const double step = opt_.load_ramp_Nm_per_s * dt;
-    const double next = load_cmd_Nm_ + std::clamp(load_target_Nm_ - load_cmd_Nm_, -step, step);
-    // Intermediate setpoints on a 1/1024 N m grid, exact in a 32-bit float register: the ramp
-    // commands the same torques over Modbus as in-process.
-    // (A ramp slower than one grid step per tick moves unrounded rather than not at all.)
-    const double on_grid = std::round(next * 1024.0) / 1024.0;
-    load_cmd_Nm_ = (next == load_target_Nm_ || on_grid == load_cmd_Nm_) ? next : on_grid;
-  }
-  load_pending_ = load_cmd_Nm_ != load_target_Nm_;
-  return check(dev_.load->set_torque_Nm(load_cmd_Nm_), "setting load torque");
+  const double cmd = load_ramp_.step(dt);
+  load_pending_ = !load_ramp_.done();
+  return check(dev_.load->set_torque_Nm(cmd), "setting load torque");
 }
 
 void PointProcedure::tick(double now_s) {
@@ -110,7 +101,7 @@ void PointProcedure::tick(double now_s) {
         if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
         if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
         if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
-        load_cmd_Nm_ = lt.torque_Nm;
+        load_ramp_.start(lt.torque_Nm, lt.torque_Nm);
         command_load(req_.load_Nm);
         t_last_tick_ = now_s;
         enter(PointPhase::load_up, now_s);

@@ -8,6 +8,7 @@
 #include <string>
 #include <system_error>
 
+#include "bench/load_ramp.hpp"
 #include "bench/point_record.hpp"
 #include "bench/steady_state.hpp"
 #include "drivers/clock.hpp"
@@ -95,7 +96,8 @@ class PointProcedure {
   PointPhase phase_ = PointPhase::start;
   double t_start_ = 0, t_phase_ = 0, t_window_ = 0, t_thermal_ = -1, t_off_speed_ = -1;
   bool has_record_ = false, speed_lost_ = false;
-  double load_cmd_Nm_ = 0, load_target_Nm_ = 0, t_last_tick_ = -1;
+  LoadRamp load_ramp_;
+  double t_last_tick_ = -1;
   bool load_pending_ = false;
   PointRecord record_;
   std::string error_;

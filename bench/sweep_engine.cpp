@@ -149,14 +149,26 @@ void SweepEngine::begin_stop(SweepState final_state, double now_s, bool coast) {
   after_stop_ = final_state;
   stop_since_s_ = now_s;
   if (final_state != SweepState::running) state_ = SweepState::stopping;
-  dev_.load->set_torque_Nm(0.0);
+  // The load comes off at the bench's ramp, as between points: removed at the load drive's
+  // 10 N m/s, it let the shaft run away from EEMF-LUT at 500 rpm, 76 deg into an over-speed
+  // trip. A drive that lost the shaft (coast) has nothing to follow: off at once.
+  const auto& lt = sup_.load();
+  const double from_Nm = lt ? lt->torque_Nm : 0.0;
+  const double rate = coast ? 0.0 : options_.load_ramp_Nm_per_s;
+  stop_ramp_ = LoadRamp(rate);
+  stop_ramp_.start(from_Nm, 0.0);
+  stop_load_timeout_s_ = kStopLoadTimeout_s + (rate > 0 ? std::fabs(from_Nm) / rate : 0.0);
+  stop_tick_s_ = now_s;
+  dev_.load->set_torque_Nm(stop_ramp_.step(0.0));
 }
 
 void SweepEngine::tick_stop(double now_s) {
   const auto& st = sup_.synrm();
   const auto& lt = sup_.load();
-  const bool load_gone = lt && std::fabs(lt->torque_Nm) < 0.05;
-  if (load_gone || now_s - stop_since_s_ > kStopLoadTimeout_s) dev_.synrm->set_speed_rpm(0.0);
+  if (!stop_ramp_.done()) dev_.load->set_torque_Nm(stop_ramp_.step(now_s - stop_tick_s_));
+  stop_tick_s_ = now_s;
+  const bool load_gone = stop_ramp_.done() && lt && std::fabs(lt->torque_Nm) < 0.05;
+  if (load_gone || now_s - stop_since_s_ > stop_load_timeout_s_) dev_.synrm->set_speed_rpm(0.0);
   const bool still = st && std::fabs(st->speed_rpm) < kStoppedRpm;
   if ((still && load_gone) || (coast_ && load_gone) || now_s - stop_since_s_ > kStopSpeedTimeout_s) {
     dev_.synrm->enable(false);

@@ -16,6 +16,7 @@
 #include <system_error>
 #include <vector>
 
+#include "bench/load_ramp.hpp"
 #include "bench/point_procedure.hpp"
 #include "bench/point_record.hpp"
 #include "bench/safety_supervisor.hpp"
@@ -106,7 +107,8 @@ class SweepEngine {
   // The ordered stop between configurations or at the end.
   bool stopping_ = false, coast_ = false;
   SweepState after_stop_ = SweepState::completed;
-  double stop_since_s_ = 0;
+  double stop_since_s_ = 0, stop_tick_s_ = 0, stop_load_timeout_s_ = 0;
+  LoadRamp stop_ramp_{0.0};
   double t0_ = -1, now_ = 0;
   std::size_t measured_this_run_ = 0;
   std::string error_;

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -198,6 +200,37 @@ TEST(SweepEngine, HfiFindsTheRotorAfterAConfigurationSwitch) {
     EXPECT_LT(*r.pos_err_max_deg - *r.pos_err_min_deg, 90.0) << index << ": out of lock";
   }
   EXPECT_EQ(hfi, 2 * 19);
+}
+
+// Between configurations the engine removes the load at the bench's ramp (2 N m/s), as between
+// points, not at the load drive's 10 N m/s: removed at once, a sensorless drive at a high current
+// angle let the shaft run away into an over-speed trip.
+TEST(SweepEngine, StopsToSwitchConfigurationWithTheLoadRamped) {
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, plan_from(R"({
+    "name": "ramped stop",
+    "dimensions": {"speed_rpm": [500], "load_Nm": [3.0], "angle_deg": [56],
+                   "configurations": [{"estimator": "encoder", "pwm": "capwm"}, {"estimator": "encoder", "pwm": "aspwm"}]},
+    "window_s": 0.5,
+    "thermal": {"enabled": false}
+  })"), {}, sink);
+  double last_t = -1, last_torque = 0, fastest_Nm_per_s = 0, stop_fall_s = -1, t_high = -1;
+  run.until(e, 300, [&](double t) {
+    drivers::LoadTelemetry lt;
+    if (run.bench.devices().load->read(lt)) return;
+    if (last_t >= 0 && t - last_t > 0)
+      fastest_Nm_per_s = std::max(fastest_Nm_per_s, std::fabs(lt.torque_Nm - last_torque) / (t - last_t));
+    // After the first point: how long the torque takes from 2.5 N m down to 0.5 N m.
+    if (sink.points.size() == 1 && lt.torque_Nm > 2.5) t_high = t;
+    if (sink.points.size() == 1 && t_high >= 0 && stop_fall_s < 0 && lt.torque_Nm < 0.5) stop_fall_s = t - t_high;
+    last_t = t;
+    last_torque = lt.torque_Nm;
+  });
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 2u);
+  EXPECT_LT(fastest_Nm_per_s, 2.5) << "the load moves at the bench's 2 N m/s everywhere";
+  EXPECT_GT(stop_fall_s, 0.9) << "2 N m at 2 N m/s";
 }
 
 TEST(SweepEngine, RestartsTheDrivesAfterAPointThatLostTheSpeed) {
