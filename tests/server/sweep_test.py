@@ -39,6 +39,14 @@ def write(name, obj):
     return path
 
 
+def sweep_with_analysis(name, plan):
+    """Runs `plan` headless into NAME.db with its analysis; returns exit code, db path, analysis."""
+    db_path = os.path.join(tmp, name + ".db")
+    analysis_path = os.path.join(tmp, name + "-analysis.json")
+    rc, _, _ = run(write(name + ".json", plan), "--db", db_path, "--analysis", analysis_path, "--quiet", timeout=1200)
+    return rc, db_path, (json.load(open(analysis_path)) if os.path.exists(analysis_path) else None)
+
+
 # --- plan errors: every problem, at its JSON pointer, exit 2
 bad = write("bad.json", {"dimensions": {"speed_rpm": [500, -1], "load_Nm": {"from": 1, "to": 0.5, "step": 0.5},
                                         "angle_deg": [95]}, "window_s": 0, "bogus": 1})
@@ -114,14 +122,10 @@ check((code == 0 and state == "completed") or (code == 2 and state == "completed
 check(idx == list(range(CRASH_POINTS)), f"all {CRASH_POINTS} points exactly once ({len(idx)})")
 
 # --- the full thesis grid, encoder: the shapes of physics.md Sec. 9
-thesis = write("thesis.json", {"preset": "thesis-grid",
-                               "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
-db = os.path.join(tmp, "thesis.db")
-an_path = os.path.join(tmp, "thesis-analysis.json")
 t0 = time.time()
-code, out, err = run(thesis, "--db", db, "--analysis", an_path, "--quiet", timeout=1200)
+code, db, an = sweep_with_analysis("thesis", {"preset": "thesis-grid",
+                                             "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
 check(code == 0, f"thesis grid (encoder) completes headless in {time.time() - t0:.1f} s")
-an = json.load(open(an_path))
 curves = {(e["speed_rpm"], e["load_Nm"]): e for e in an["curves"]["entries"]}
 check(an["points"]["records"] == 665, f"665 points (5 x 7 x 19) ({an['points']['records']})")
 for speed in (100.0, 300.0, 500.0, 700.0, 900.0):
@@ -134,17 +138,14 @@ check(all(curves[k]["me"]["angle_deg"] > curves[k]["mtpa"]["angle_deg"] for k in
 check(gaps[900.0] > gaps[500.0] > gaps[100.0], f"the ME-MTPA gap grows with speed {gaps}")
 
 # --- adaptive search on the same grid: MTPA and ME within +/-1 deg with at most a third of the points
-adaptive = write("adaptive.json", {"preset": "thesis-grid", "mode": "adaptive",
-                                   "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
-db = os.path.join(tmp, "adaptive.db")
-ad_path = os.path.join(tmp, "adaptive-analysis.json")
-code, out, err = run(adaptive, "--db", db, "--analysis", ad_path, "--quiet", timeout=1200)
+code, db, ad_an = sweep_with_analysis("adaptive", {"preset": "thesis-grid", "mode": "adaptive",
+                                                  "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
 check(code == 0, "adaptive thesis grid completes")
 con = sqlite3.connect(db)
 n_adaptive = con.execute("select count(*) from points").fetchone()[0]
 state = con.execute("select state from sweeps where id = 1").fetchone()[0]
 con.close()
-ad = {(e["speed_rpm"], e["load_Nm"]): e for e in json.load(open(ad_path))["curves"]["entries"]}
+ad = {(e["speed_rpm"], e["load_Nm"]): e for e in ad_an["curves"]["entries"]}
 worst_mtpa = max(abs(ad[k]["mtpa"]["angle_deg"] - curves[k]["mtpa"]["angle_deg"]) for k in curves)
 worst_me = max(abs(ad[k]["me"]["angle_deg"] - curves[k]["me"]["angle_deg"]) for k in curves)
 print(f"     adaptive: {n_adaptive} points vs 665 ({n_adaptive / 665:.2f}), worst MTPA {worst_mtpa:.2f} deg, "
@@ -157,21 +158,18 @@ check(worst_mtpa <= 1.0 and worst_me <= 1.0, "MTPA and ME within +/-1 deg of the
 # averaged gate lets HFI's points settle (without it every one timed out, flagged unstable, and
 # the analysis, which leaves those out, had no HFI at all); HFI then costs current and input
 # power on both optimal trajectories, and ASPWM saves input power.
-inj = write("injection.json", {"preset": "thesis-grid",
-                               "dimensions": {"speed_rpm": [300], "load_Nm": [1.0, 2.0, 3.0],
-                                              "configurations": [{"estimator": "encoder", "pwm": "capwm"},
-                                                                 {"estimator": "hfi", "pwm": "capwm"},
-                                                                 {"estimator": "encoder", "pwm": "aspwm"}]}})
-db = os.path.join(tmp, "injection.db")
-inj_path = os.path.join(tmp, "injection-analysis.json")
-code, out, err = run(inj, "--db", db, "--analysis", inj_path, "--quiet", timeout=1200)
+code, db, inj_an = sweep_with_analysis("injection", {
+    "preset": "thesis-grid",
+    "dimensions": {"speed_rpm": [300], "load_Nm": [1.0, 2.0, 3.0],
+                   "configurations": [{"estimator": "encoder", "pwm": "capwm"}, {"estimator": "hfi", "pwm": "capwm"},
+                                      {"estimator": "encoder", "pwm": "aspwm"}]}})
 check(code == 0, "encoder / HFI / ASPWM sweep at 300 rpm completes")
 con = sqlite3.connect(db)
 unstable_hfi = con.execute("select count(*) from points where estimator = 'hfi' and unstable").fetchone()[0]
 n_hfi = con.execute("select count(*) from points where estimator = 'hfi'").fetchone()[0]
 con.close()
 check(n_hfi == 3 * 19 and unstable_hfi <= 3, f"HFI points settle through the averaged gate ({unstable_hfi} of {n_hfi} unstable)")
-deltas = {(e["estimator"], e["pwm"], e["load_Nm"]): e for e in json.load(open(inj_path))["deltas"]["entries"]}
+deltas = {(e["estimator"], e["pwm"], e["load_Nm"]): e for e in inj_an["deltas"]["entries"]}
 for load in (1.0, 2.0, 3.0):
     h = deltas.get(("hfi", "capwm", load))
     a = deltas.get(("encoder", "aspwm", load))
