@@ -30,7 +30,7 @@ struct HfiParams {
   double stiffness_current_filter_s = 0.02;  // [assumed] smoothing of the currents it takes
   // [assumed] Initial position detection: after a start the carrier runs this long with no
   // torque current, so the PLL finds the rotor before the speed loop turns the shaft with a
-  // wrong angle (a start 50 deg off drove the shaft backwards into an over-current trip).
+  // wrong angle (a start 58 deg off drove the shaft backwards into an over-current trip).
   double align_s = 0.1;
 };
 
