@@ -36,12 +36,18 @@ void PointProcedure::enter(PointPhase p, double now_s) {
   t_phase_ = now_s;
 }
 
-void PointProcedure::begin_stop(double now_s) {
-  // Ordered stop, step one: the load first, so the SynRM is never driven by the load. Not
-  // ramped by the bench: the load drive ramps it, and a stop must not wait on the bench's ticks.
-  dev_.load->set_torque_Nm(0.0);
-  load_ramp_.start(0.0, 0.0);
-  load_pending_ = false;
+void PointProcedure::begin_stop(double now_s, bool ramped) {
+  // Ordered stop, step one: the load first, so the SynRM is never driven by the load. After a
+  // measured point at the bench's ramp, as between points (a sensorless drive at a high current
+  // angle must follow the acceleration); after a fault at once (the load drive's own ramp): a
+  // faulted stop must not wait on the bench's ticks.
+  if (ramped) {
+    command_load(0.0);
+  } else {
+    dev_.load->set_torque_Nm(0.0);
+    load_ramp_.start(0.0, 0.0);
+    load_pending_ = false;
+  }
   enter(PointPhase::stop, now_s);
 }
 
@@ -74,13 +80,16 @@ void PointProcedure::tick(double now_s) {
     if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
     if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
     const auto fault = st.fault != drivers::Fault::none ? st.fault : lt.fault;
-    if (fault != drivers::Fault::none && phase_ != PointPhase::stop) {
-      record_.fault = std::string(drivers::fault_name(fault));
-      error_ = "fault latched during the point: " + *record_.fault;
-      begin_stop(now_s);
+    if (fault != drivers::Fault::none && (phase_ != PointPhase::stop || load_pending_)) {
+      // A fault during the ramped stop of a measured point takes the load off at once too.
+      if (phase_ != PointPhase::stop) {
+        record_.fault = std::string(drivers::fault_name(fault));
+        error_ = "fault latched during the point: " + *record_.fault;
+      }
+      begin_stop(now_s, /*ramped=*/false);
       return;
     }
-    if (phase_ != PointPhase::stop && !ramp_load(now_s)) return;
+    if (!ramp_load(now_s) && phase_ != PointPhase::stop) return;
   }
 
   switch (phase_) {
@@ -183,7 +192,7 @@ void PointProcedure::tick(double now_s) {
       read_results();
       if (phase_ == PointPhase::failed) return;
       if (opt_.ordered_stop_after) {
-        begin_stop(now_s);
+        begin_stop(now_s, /*ramped=*/true);
       } else {
         enter(PointPhase::done, now_s);
       }
@@ -192,7 +201,7 @@ void PointProcedure::tick(double now_s) {
     case PointPhase::stop: {
       // Step two once the load torque is gone: speed to zero; step three: disable.
       const bool timed_out = now_s - t_phase_ > opt_.stop_timeout_s;
-      const bool load_gone = std::fabs(lt.torque_Nm) < 0.05;
+      const bool load_gone = !load_pending_ && std::fabs(lt.torque_Nm) < 0.05;
       if (load_gone || timed_out) dev_.synrm->set_speed_rpm(0.0);
       if ((std::fabs(st.speed_rpm) < opt_.stop_speed_rpm && load_gone) || timed_out ||
           st.state == drivers::DriveState::faulted) {

@@ -85,7 +85,8 @@ class PointProcedure {
   // The load torque the procedure wants; ramp_load() moves the setpoint there each tick.
   void command_load(double target_Nm);
   bool ramp_load(double now_s);
-  void begin_stop(double now_s);
+  // `ramped`: the load comes off at the bench's ramp (a measured point), else at once (a fault).
+  void begin_stop(double now_s, bool ramped);
   void read_results();
   void enter(PointPhase p, double now_s);
 

@@ -99,7 +99,7 @@ std::optional<SweepEngine::Next> SweepEngine::next_point() {
 void SweepEngine::start_point(const Next& n, double now_s) {
   current_ = n;
   PointOptions options = options_;
-  options.gate.average_s = point_options(plan_, config_of(n.point.request)).gate.average_s;
+  options.gate.average_s = gate_average_s(plan_, config_of(n.point.request));
   proc_ = std::make_unique<PointProcedure>(dev_, n.point.request, options);
   proc_->tick(now_s);
 }

@@ -193,10 +193,15 @@ PointOptions point_options(const SweepPlan& plan) {
   return o;
 }
 
+double gate_average_s(const SweepPlan& plan, const Configuration& c) {
+  for (const auto& pc : plan.configurations)
+    if (pc.configuration == c && pc.gate_average_s) return *pc.gate_average_s;
+  return plan.gate.bands.average_s;
+}
+
 PointOptions point_options(const SweepPlan& plan, const Configuration& c) {
   PointOptions o = point_options(plan);
-  for (const auto& pc : plan.configurations)
-    if (pc.configuration == c && pc.gate_average_s) o.gate.average_s = *pc.gate_average_s;
+  o.gate.average_s = gate_average_s(plan, c);
   return o;
 }
 
@@ -291,7 +296,7 @@ SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& m) {
   e.points = steps.size();
   // The gate needs its span of (averaged) samples before it can pass.
   auto per_point_s = [&](const Configuration& c) {
-    const double gate_s = plan.gate.bands.span_s + point_options(plan, c).gate.average_s;
+    const double gate_s = plan.gate.bands.span_s + gate_average_s(plan, c);
     return std::max(plan.gate.min_settle_s, gate_s) + m.settle_extra_s + plan.window_s;
   };
   double speed = 0, load = 0, t = 0;

@@ -151,6 +151,8 @@ PlannedPoint adaptive_point(const SweepPlan& plan, const PlannedGroup& group, st
 // with a configuration, its gate_average_s replaces the plan's where it has one.
 PointOptions point_options(const SweepPlan& plan);
 PointOptions point_options(const SweepPlan& plan, const Configuration& c);
+// The gate's averaging time for a configuration's points: its own, else the plan's.
+double gate_average_s(const SweepPlan& plan, const Configuration& c);
 
 // The safety supervisor's limits from the plan's (those SafetyLimits has).
 SafetyLimits safety_limits(const SweepPlan& plan);
