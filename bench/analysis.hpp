@@ -25,6 +25,8 @@ struct AnalysisOptions {
   bool exclude_voltage_limited = true;
   // Measured on the low-speed fallback: not the configuration's own estimator.
   bool exclude_below_min_speed = true;
+  // Run on the encoder after the drive's lock guard took over: not the estimator either.
+  bool exclude_lock_lost = true;
   // Histogram bin widths of the thesis (Figs. 6.16 to 6.19).
   double pos_err_bin_deg = 0.5;
   double ld_err_bin_pct = 5.0;

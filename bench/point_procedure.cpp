@@ -90,6 +90,8 @@ void PointProcedure::tick(double now_s) {
       return;
     }
     if (!ramp_load(now_s) && phase_ != PointPhase::stop) return;
+    // Until the window closes: the guard hands back only at the next point's setpoints.
+    if (st.lock_lost && phase_ != PointPhase::stop) record_.lock_lost = true;
   }
 
   switch (phase_) {
@@ -157,6 +159,12 @@ void PointProcedure::tick(double now_s) {
       const bool timed_out = now_s - t_phase_ > opt_.settle_timeout_s;
       if (speed_lost_) {
         record_.unstable = true;
+        open_window(now_s);
+        return;
+      }
+      if (record_.lock_lost) {
+        // The estimator lost the rotor and the drive runs on the encoder until the next point:
+        // there is no steady state of the estimator to wait for. Measured at once, flagged.
         open_window(now_s);
         return;
       }
@@ -258,6 +266,7 @@ void PointProcedure::read_results() {
   r.voltage_limited = w.voltage_limited_fraction > 0;
   r.fallback_fraction = w.fallback_fraction;
   r.below_min_speed = w.fallback_fraction > 0.5;
+  if (w.lock_lost_fraction > 0) r.lock_lost = true;
   if (w.fault != drivers::Fault::none) r.fault = std::string(drivers::fault_name(w.fault));
   if (dev_.truth) r.truth = dev_.truth->read_truth_window();
   has_record_ = true;

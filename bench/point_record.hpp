@@ -34,6 +34,9 @@ struct PointRecord {
   // the encoder) for most of the window: the estimator fields describe the fallback, not it.
   bool below_min_speed = false;
   double fallback_fraction = 0;  // share of the window's samples on the fallback, 0..1
+  // The estimator lost the rotor during the point: the drive's lock guard ran it on the encoder
+  // from then on, so its values are not the estimator's (docs/estimators.md).
+  bool lock_lost = false;
   // emulator only: the plant's own values over the window
   std::optional<drivers::TruthWindow> truth;
 };

@@ -130,6 +130,12 @@ void SweepEngine::finish_point(double /*now_s*/) {
   if (n.search) searches_[*n.search].report(r.angle_deg, r.im_A, r.pdcm_W);
   if (plan_.mode == SweepMode::grid) ++grid_pos_;
   sink_.progress(progress());
+  if (r.lock_lost) {
+    // Not a fault: the estimator's limit at this point. The drive's lock guard already runs on
+    // the encoder and hands back at the next point's setpoints.
+    sink_.event("log", "point " + std::to_string(n.point.index) +
+                           ": the estimator lost the rotor; the drive's lock guard ran the point on the encoder");
+  }
   if (proc->speed_lost()) {
     // The drive lost the speed (a sensorless observer that slipped off the rotor does not find
     // it again while the shaft stalls): ordered stop, and the next point starts from standstill.

@@ -98,9 +98,16 @@ ALTER TABLE points ADD COLUMN below_min_speed INTEGER NOT NULL DEFAULT 0 CHECK (
 ALTER TABLE points ADD COLUMN fallback_fraction ANY DEFAULT 0 CHECK (typeof(fallback_fraction) IN ('real', 'integer', 'null'));
 )sql";
 
+// Version 3: the drive's lock guard ran the point on the encoder (the estimator lost the rotor).
+// Rows from before ran without a guard (0).
+constexpr std::string_view kSchemaV3 = R"sql(
+ALTER TABLE points ADD COLUMN lock_lost INTEGER NOT NULL DEFAULT 0 CHECK (lock_lost IN (0, 1));
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
+    Migration{3, "points: lock_lost", kSchemaV3},
 };
 
 struct Header {

@@ -27,7 +27,7 @@ struct RecordColumn {
   Member member;
 };
 
-inline const std::array<RecordColumn, 37> kRecordColumns{{
+inline const std::array<RecordColumn, 38> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
@@ -65,6 +65,7 @@ inline const std::array<RecordColumn, 37> kRecordColumns{{
     {"fault", &PointRecord::fault},
     {"below_min_speed", &PointRecord::below_min_speed},    // schema version 2
     {"fallback_fraction", &PointRecord::fallback_fraction},
+    {"lock_lost", &PointRecord::lock_lost},                // schema version 3
 }};
 
 }  // namespace synbench::db::detail

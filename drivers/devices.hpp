@@ -30,6 +30,9 @@ struct SynrmTelemetry {
   // Estimated minus encoder electrical angle, wrapped to (-90, 90] deg, at the last control
   // period; empty when the encoder is the position source.
   std::optional<double> pos_err_deg;
+  // The drive's lock guard took the angle from a sensorless estimator that left the encoder's
+  // (a slipped observer) and runs on the encoder until the next operating point is commanded.
+  bool lock_lost = false;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;
 };
@@ -44,6 +47,8 @@ struct SynrmWindow {
   // Fraction of the samples in which a low-speed fallback gave the angle instead of the selected
   // estimator (an EEMF observer below its minimum speed hands over to HFI or the encoder).
   double fallback_fraction = 0;
+  // Fraction of the samples the lock guard ran on the encoder (see SynrmTelemetry::lock_lost).
+  double lock_lost_fraction = 0;
   // Estimator outputs; empty when the position source is the encoder.
   std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
   std::optional<double> ld_est_H, lq_est_H, rs_est_ohm;

@@ -146,6 +146,11 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("firmware.speed_ramp_rpm_per_s", &f.speed_ramp_rpm_per_s, "assumed", "speed setpoint ramp", A);
   b.pos("firmware.sensorless_angle_slew_deg_per_s", &f.sensorless_angle_slew_deg_per_s, "assumed",
         "current-angle rate limit while an estimator is the position source", A);
+  b.num("firmware.lock_guard_deg", &f.lock_guard_deg, 0, 90, "assumed",
+        "lock guard: estimated minus encoder angle beyond which the encoder takes over until the next point (0: off)", A);
+  b.num("firmware.lock_guard_s", &f.lock_guard_s, 0, 1, "assumed", "lock guard: how long the angle must stay beyond it", A);
+  b.num("firmware.lock_guard_current_A", &f.lock_guard_current_A, 0, 100, "assumed",
+        "lock guard: or a current vector above this, sensorless (0: off)", A);
   b.pos("firmware.telemetry_filter_s", &f.telemetry_filter_s, "assumed", "time constant of telemetry low-pass filters", A);
   b.pos("firmware.max_speed_rpm", &f.max_speed_rpm, "Table 1.1", "largest speed setpoint accepted");
   b.pos("firmware.overspeed_trip_rpm", &f.overspeed_trip_rpm, "assumed", "over-speed trip", A);

@@ -46,6 +46,7 @@ constexpr SignalSpec kSynrm[] = {
     {"temp_C", R::telemetry, false, "C", "power-stage temperature"},
     {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
     {"pos_err_deg", R::telemetry, false, "deg", "estimated minus encoder angle, last control period; not with the encoder"},
+    {"lock_lost", R::telemetry, false, "", "1 while the lock guard runs a sensorless drive on the encoder (until the next setpoint)"},
     {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
     {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, true, "", "control periods accumulated"},
@@ -68,6 +69,7 @@ constexpr SignalSpec kSynrm[] = {
     {"window_lq_est_H", R::window_result, false, "H", "estimated q inductance, mean; not with the encoder"},
     {"window_rs_est_ohm", R::window_result, false, "ohm", "estimated stator resistance, mean; not with the encoder"},
     {"window_fallback_fraction", R::window_result, false, "", "fraction of samples on the low-speed fallback source, 0..1"},
+    {"window_lock_lost_fraction", R::window_result, false, "", "fraction of samples the lock guard ran on the encoder, 0..1"},
 };
 
 constexpr SignalSpec kLoad[] = {

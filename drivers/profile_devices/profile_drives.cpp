@@ -35,12 +35,12 @@ ProfileDevice::ProfileDevice(RegisterBus& bus, DeviceProfile profile)
 ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::synrm_drive), std::move(profile))),
       telemetry_(this->profile(), {"state", "fault_code", "speed_rpm", "im_A", "id_A", "iq_A", "ud_V",
-                                   "uq_V", "udc_V", "pac_W", "temp_C", "voltage_limited", "pos_err_deg"}),
+                                   "uq_V", "udc_V", "pac_W", "temp_C", "voltage_limited", "pos_err_deg", "lock_lost"}),
       window_(this->profile(),
               {"window_status", "window_sequence", "window_samples", "window_fault_code", "window_s",
                "window_speed_meas_rpm", "window_im_A", "window_id_A", "window_iq_A", "window_ud_V",
                "window_uq_V", "window_udc_V", "window_temp_C", "window_voltage_limited_fraction",
-               "window_fallback_fraction"}),
+               "window_fallback_fraction", "window_lock_lost_fraction"}),
       estimator_window_(this->profile(),
                         {"window_pos_err_min_deg", "window_pos_err_mean_deg", "window_pos_err_max_deg",
                          "window_speed_err_rpm", "window_ld_est_H", "window_lq_est_H",
@@ -69,7 +69,7 @@ std::error_code ProfileSynrmDrive::set_estimator(Estimator estimator) {
 }
 
 std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
-  double v[13];
+  double v[14];
   if (auto ec = io().read(telemetry_, v)) return ec;
   out.state = static_cast<DriveState>(static_cast<int>(v[0]));
   out.fault = static_cast<Fault>(static_cast<int>(v[1]));
@@ -85,11 +85,12 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   out.voltage_limited = or_(v[11]) != 0;
   // The register reads 0 with the encoder; a profile without it leaves the field empty.
   out.pos_err_deg = estimator_ != Estimator::encoder ? opt(v[12]) : std::nullopt;
+  out.lock_lost = or_(v[13]) != 0;
   return {};
 }
 
 std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
-  double v[15];
+  double v[16];
   if (auto ec = window().read_results(window_, v)) return ec;
   SynrmWindow w;
   w.samples = static_cast<std::uint32_t>(v[2]);
@@ -105,6 +106,7 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   w.temp_C = or_(v[12]);
   w.voltage_limited_fraction = or_(v[13]);
   w.fallback_fraction = or_(v[14]);
+  w.lock_lost_fraction = or_(v[15]);
   if (estimator_ != Estimator::encoder) {
     // Read after the sequence check: the next window cannot open before this bench starts it.
     double e[7];

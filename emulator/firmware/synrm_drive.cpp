@@ -13,6 +13,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kRpmPerRadS = 60.0 / (2.0 * kPi);
 // An ordered stop ends (gates off) below this speed.
 constexpr double kStoppedRpm = 20.0;
+// Zero current after a lock guard trip [assumed]: several current-loop time constants (4 ms).
+constexpr double kGuardRecovery_s = 0.02;
 
 double wrap_pi(double x) {
   x = std::fmod(x + kPi, 2.0 * kPi);
@@ -90,6 +92,7 @@ std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
   if (!std::isfinite(speed_rpm) || std::fabs(speed_rpm) > cfg_.firmware.max_speed_rpm)
     return make_error_code(errc::invalid_argument);
   speed_set_rpm_ = speed_rpm;
+  rearm_guard();
   return {};
 }
 
@@ -98,7 +101,13 @@ std::error_code SynrmDriveFirmware::set_angle_deg(double angle_deg) {
     return make_error_code(errc::invalid_argument);
   angle_set_rad_ = angle_deg * kPi / 180.0;
   if (state_ != drivers::DriveState::running) angle_rad_ = angle_set_rad_;
+  rearm_guard();
   return {};
+}
+
+void SynrmDriveFirmware::rearm_guard() {
+  // A new operating point hands the angle back to the estimator after a lock guard trip.
+  if (estimator_) estimator_->rearm();
 }
 
 std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {
@@ -205,6 +214,17 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     const EstimatorOutput o = estimator_->output();
     theta_e = wrap_pi(o.theta_e_rad);
     we = o.omega_e_rad_s;
+    if (estimator_->lock_lost() && !guard_held_) {
+      // The lock guard moved the frame onto the encoder's in one period, with the current off
+      // its reference by amperes and the current loops' integrators holding tens of volts of
+      // correction for the lost frame's wrong back-EMF: carried on, that drove the current into
+      // the over-current trip. The drive lets the current down first (a SynRM has no magnet
+      // to drive current through zero volts), then the speed loop resumes on the encoder.
+      id_pi_.reset();
+      iq_pi_.reset();
+      guard_recovery_steps_ = static_cast<long>(std::lround(kGuardRecovery_s / ts_));
+    }
+    guard_held_ = estimator_->lock_lost();
   }
   const double speed_ctrl_rpm = we / pole_pairs_ * kRpmPerRadS;
   const double ca = std::cos(theta_e), sa = std::sin(theta_e);
@@ -221,7 +241,8 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) {
     // Speed loop at its own rate, on a ramped reference; held at zero current while the
     // estimator is still finding the rotor (the reference ramp waits with it).
-    if (estimator_ && estimator_->aligning()) {
+    if (guard_recovery_steps_ > 0) --guard_recovery_steps_;
+    if ((estimator_ && estimator_->aligning()) || guard_recovery_steps_ > 0) {
       speed_pi_.reset();
       im_req_A_ = 0;
     } else if (step_ % static_cast<std::uint64_t>(speed_divider_) == 0) {
@@ -321,6 +342,7 @@ void SynrmDriveFirmware::begin_window(std::int64_t steps) {
   window_count_start_ = -1;
   window_limited_ = 0;
   window_fallback_ = 0;
+  window_lock_lost_ = 0;
   window_fault_ = state_ == drivers::DriveState::faulted ? fault_ : drivers::Fault::none;
   for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_, &w_pos_err_,
                          &w_speed_err_, &w_ld_, &w_lq_, &w_rs_, &w_id_enc_, &w_iq_enc_})
@@ -347,6 +369,7 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     w_iq_enc_.add(sn * id + c * iq);
     w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
     window_fallback_ += estimator_->on_fallback() ? 1 : 0;
+    window_lock_lost_ += estimator_->lock_lost() ? 1 : 0;
     w_speed_err_.add(speed_err_rpm);
     const EstimatorOutput o = estimator_->output();
     if (o.ld_H) w_ld_.add(*o.ld_H);
@@ -370,6 +393,7 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   r.temp_C = w_temp_.mean();
   r.voltage_limited_fraction = static_cast<double>(window_limited_) / static_cast<double>(r.samples);
   r.fallback_fraction = static_cast<double>(window_fallback_) / static_cast<double>(r.samples);
+  r.lock_lost_fraction = static_cast<double>(window_lock_lost_) / static_cast<double>(r.samples);
   r.fault = state_ == drivers::DriveState::faulted ? fault_ : window_fault_;
   if (estimator_) {
     r.pos_err_min_deg = w_pos_err_.min();
@@ -402,6 +426,7 @@ drivers::SynrmTelemetry SynrmDriveFirmware::telemetry() const {
   t.temp_C = f_temp_.value();
   t.voltage_limited = limited_hold_s_ > 0;
   if (estimator_) t.pos_err_deg = pos_err_deg_;
+  t.lock_lost = estimator_ && estimator_->lock_lost();
   t.state = state_;
   t.fault = fault_;
   return t;

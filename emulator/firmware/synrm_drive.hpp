@@ -75,6 +75,7 @@ class SynrmDriveFirmware {
  private:
   void check_protection(const DriveSample& s, double ia, double ib, double speed_rpm);
   void gates_off();
+  void rearm_guard();
   void accumulate(const DriveSample& s, double im, double id, double iq, bool limited,
                   double theta_enc, double speed_enc_rpm);
 
@@ -100,6 +101,8 @@ class SynrmDriveFirmware {
   drivers::Estimator estimator_kind_ = drivers::Estimator::encoder;
   std::unique_ptr<Estimator> estimator_;
   bool needs_mcidc_ = false;
+  bool guard_held_ = false;       // the lock guard held in the last period
+  long guard_recovery_steps_ = 0; // zero current after a lock guard trip, then the speed loop
   // Voltages commanded one and two periods ago, without the dead-time compensation: the older
   // one acted during the last period.
   double u_hist_[2][2] = {{0, 0}, {0, 0}};
@@ -121,6 +124,7 @@ class SynrmDriveFirmware {
   std::int64_t window_count_start_ = 0;
   long window_limited_ = 0;
   long window_fallback_ = 0;  // samples on the estimator's low-speed fallback
+  long window_lock_lost_ = 0; // samples on the encoder after a lock guard trip
   double pos_err_deg_ = 0;    // estimated minus encoder angle, last period, (-90, 90] deg
   drivers::Fault window_fault_ = drivers::Fault::none;
   WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;

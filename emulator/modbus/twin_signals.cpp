@@ -71,6 +71,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
     if (n == "window_lq_est_H") return or0(w.lq_est_H);
     if (n == "window_rs_est_ohm") return or0(w.rs_est_ohm);
     if (n == "window_fallback_fraction") return w.fallback_fraction;
+    if (n == "window_lock_lost_fraction") return w.lock_lost_fraction;
     return 0;
   }
   const drivers::SynrmTelemetry t = fw.telemetry();
@@ -87,6 +88,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
   if (n == "temp_C") return t.temp_C;
   if (n == "voltage_limited") return t.voltage_limited ? 1 : 0;
   if (n == "pos_err_deg") return or0(t.pos_err_deg);
+  if (n == "lock_lost") return t.lock_lost ? 1 : 0;
   return 0;
 }
 

@@ -119,7 +119,7 @@ nlohmann::json status_json(const BenchStatus& s) {
     const auto& t = *s.synrm;
     j["synrm"] = {{"speed_rpm", t.speed_rpm}, {"im_A", t.im_A},     {"id_A", t.id_A},     {"iq_A", t.iq_A},
                   {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
-                  {"temp_C", t.temp_C},       {"voltage_limited", t.voltage_limited},
+                  {"temp_C", t.temp_C},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
                   {"pos_err_deg", t.pos_err_deg ? nlohmann::json(*t.pos_err_deg) : nlohmann::json(nullptr)},
                   {"state", state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
   } else {

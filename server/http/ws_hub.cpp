@@ -32,9 +32,9 @@ std::string telemetry_message(const BenchStatus& s, double sent_unix_ms) {
   // The drive's own estimate of its output power, 1.5 (ud id + uq iq): not a DC-side measurement.
   j["pac_W"] = s.synrm ? nlohmann::json(s.synrm->pac_W) : null;
   j["temp_C"] = s.synrm ? nlohmann::json(s.synrm->temp_C) : null;
-  // The drives' live telemetry carries no position error (only a measurement window does).
   j["pos_err_deg"] = s.synrm && s.synrm->pos_err_deg ? nlohmann::json(*s.synrm->pos_err_deg) : null;
   j["voltage_limited"] = s.synrm ? nlohmann::json(s.synrm->voltage_limited) : null;
+  j["lock_lost"] = s.synrm ? nlohmann::json(s.synrm->lock_lost) : null;
   j["fault"] = s.synrm ? nlohmann::json(std::string(drivers::fault_name(s.synrm->fault))) : null;
   return j.dump();
 }

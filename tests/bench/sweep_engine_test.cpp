@@ -163,9 +163,6 @@ TEST(SweepEngine, EndsFaultedWhenTheSupervisorTrips) {
   EXPECT_TRUE(run.sup.tripped());
 }
 
-}  // namespace
-}  // namespace synbench::bench
-
 namespace synbench::bench {
 namespace {
 
@@ -258,6 +255,55 @@ TEST(SweepEngine, RestartsTheDrivesAfterAPointThatLostTheSpeed) {
   bool logged = false;
   for (const auto& ev : sink.events)
     logged = logged || ev.find("could not hold 500 rpm") != std::string::npos;
+  EXPECT_TRUE(logged);
+}
+
+}  // namespace
+}  // namespace synbench::bench
+
+// The drive's lock guard (docs/estimators.md): EEMF-RLS at 500 rpm through the thesis grid lost
+// the rotor and tripped the drive on over-current after a few dozen points, which ended the
+// sweep. Guarded, the points where it lost the rotor are flagged `lock_lost` and the sweep
+// completes; the points it holds keep the estimator's own errors.
+TEST(SweepEngine, TheLockGuardKeepsAnEemfRlsSweepGoingWhereItTripped) {
+  const char* plan = R"({
+    "name": "rls at 500 rpm",
+    "preset": "thesis-grid",
+    "dimensions": {"speed_rpm": [500], "configurations": [{"estimator": "eemf-rls", "pwm": "capwm"}]}
+  })";
+  auto run_with = [&](double guard_deg, VectorSink& sink) {
+    emulator::TwinConfig cfg;
+    cfg.firmware.lock_guard_deg = guard_deg;
+    TwinRun run{cfg};
+    SweepEngine e(run.bench.devices(), run.sup, plan_from(plan), {}, sink);
+    run.until(e, 7200);
+    return std::make_pair(e.state(), e.error());
+  };
+  VectorSink unguarded;
+  const auto [state_off, error_off] = run_with(0.0, unguarded);
+  EXPECT_EQ(state_off, SweepState::faulted);
+  EXPECT_NE(error_off.find("overcurrent"), std::string::npos) << error_off;
+  EXPECT_LT(unguarded.points.size(), 133u);
+
+  VectorSink guarded;
+  const auto [state_on, error_on] = run_with(45.0, guarded);
+  ASSERT_EQ(state_on, SweepState::completed) << error_on;
+  ASSERT_EQ(guarded.points.size(), 133u);
+  int lost = 0, held = 0;
+  for (const auto& [index, r] : guarded.points) {
+    EXPECT_FALSE(r.fault) << index;
+    if (r.lock_lost) {
+      ++lost;
+      continue;
+    }
+    ++held;
+    ASSERT_TRUE(r.pos_err_mean_deg && r.rs_est_ohm) << index;
+    EXPECT_LT(std::fabs(*r.pos_err_mean_deg), 10.0) << index;
+  }
+  EXPECT_GT(lost, 0);
+  EXPECT_GE(held, 15) << "the light-load points hold, as without the guard";
+  bool logged = false;
+  for (const auto& ev : guarded.events) logged = logged || ev.find("lock guard") != std::string::npos;
   EXPECT_TRUE(logged);
 }
 

@@ -141,9 +141,10 @@ TEST(Migrations, ReportAnUnopenableFile) {
   EXPECT_EQ(Store::open("").code(), errc::invalid_argument);
 }
 
-TEST(Migrations, AVersion1FileGainsTheMinimumSpeedColumns) {
-  // A file as version 1 left it (the columns of step 2 dropped again, user_version 1): opening it
-  // applies step 2, and its points read back with the new fields at their defaults.
+TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
+  // A file as version 1 left it (the columns of steps 2 and 3 dropped again, user_version 1):
+  // opening it applies the later steps, and its points read back with the new fields at their
+  // defaults.
   TempDir dir;
   const auto path = dir / "v1.db";
   std::int64_t id = 0;
@@ -157,21 +158,24 @@ TEST(Migrations, AVersion1FileGainsTheMinimumSpeedColumns) {
     auto r = testing::sample_record(3);
     r.below_min_speed = true;
     r.fallback_fraction = 0.9;
+    r.lock_lost = true;
     ASSERT_TRUE(store->insert_point(id, 0, r));
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN lock_lost");
     raw.exec("ALTER TABLE points DROP COLUMN fallback_fraction");
     raw.exec("ALTER TABLE points DROP COLUMN below_min_speed");
     raw.exec("PRAGMA user_version = 1");
   }
   auto store = Store::open(path);
   ASSERT_TRUE(store) << store.error().message;
-  EXPECT_EQ(store->pragma("user_version").value(), "2");
+  EXPECT_EQ(store->pragma("user_version").value(), std::to_string(schema_version()));
   const auto rows = store->points(id).value();
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_FALSE(rows[0].record.below_min_speed);
   EXPECT_EQ(rows[0].record.fallback_fraction, 0.0);
+  EXPECT_FALSE(rows[0].record.lock_lost);
   EXPECT_EQ(rows[0].record.im_A, testing::sample_record(3).im_A);
 }
 
@@ -225,10 +229,11 @@ TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
   const auto path = dir / "schema.db";
   { ASSERT_TRUE(Store::open(path)); }
   // Version 1's columns, then those later migrations added (ALTER TABLE appends them).
-  const std::vector<std::string> added{"below_min_speed", "fallback_fraction"};
-  ASSERT_EQ(std::vector<std::string>(record_fields.end() - 2, record_fields.end()), added);
+  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost"};
+  const auto n_added = static_cast<std::ptrdiff_t>(added.size());
+  ASSERT_EQ(std::vector<std::string>(record_fields.end() - n_added, record_fields.end()), added);
   std::vector<std::string> expected{"id", "sweep_id", "point_index"};
-  expected.insert(expected.end(), record_fields.begin(), record_fields.end() - 2);
+  expected.insert(expected.end(), record_fields.begin(), record_fields.end() - n_added);
   expected.insert(expected.end(), {"truth_json", "measured_at"});
   expected.insert(expected.end(), added.begin(), added.end());
   EXPECT_EQ(Raw(path).column("SELECT name FROM pragma_table_info('points') ORDER BY cid"), expected);

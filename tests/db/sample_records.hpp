@@ -60,6 +60,7 @@ inline bench::PointRecord sample_record(std::int64_t i) {
   r.unstable = i % 6 == 5;
   r.below_min_speed = i % 5 == 2;
   r.fallback_fraction = r.below_min_speed ? 1.0 - 1.0 / (3.0 + x) : 0.0;
+  r.lock_lost = i % 7 == 4;
   if (i % 5 == 3) r.fault = i % 10 == 3 ? "overcurrent" : "link_loss, \"quoted\"";  // CSV quoting
   if (i % 3 != 0) {
     drivers::TruthWindow t;

@@ -3,10 +3,10 @@
 // gate deciding when a point has settled, the thermal precondition, the restart after a lost
 // speed), with the records kept in memory instead of SQLite. A fresh twin per point
 // (estimator_grid) hides what a sweep meets: the observer must carry its lock through every
-// setpoint change. Prints per-speed counts of points, points flagged unstable and points out of
-// lock (position-error span over 90 deg: a slipping observer sweeps the whole (-90, 90] deg), the
-// worst |mean position error| in lock, the mean settling time, the restarts, the sweep's end
-// state and the wall time. Exits 1 when the sweep does not complete.
+// setpoint change. Prints per-speed counts of points, points flagged unstable, points the drive's
+// lock guard ran on the encoder, points out of lock (position-error span over 90 deg: a slipping
+// observer sweeps the whole (-90, 90] deg), the worst |mean position error| in lock, the mean
+// settling time, the restarts, the sweep's end state and the wall time. Exits 1 when the sweep does not complete.
 // usage: estimator_chain --estimator NAME [--pwm capwm|aspwm] [--speeds a,b,..] [--loads ..]
 //                        [--angles ..] [--timeout-s S] [--config FILE] [--verbose]
 //   defaults: the thesis-grid preset (EEMF variants from 500 rpm, HFI up to 300 rpm), the thesis
@@ -44,7 +44,7 @@ std::vector<double> list(const char* s) {
 }
 
 struct Tally {
-  int points = 0, unstable = 0, out_of_lock = 0;
+  int points = 0, unstable = 0, lock_lost = 0, out_of_lock = 0;
   double worst_in_lock_deg = 0, settle_sum_s = 0;
 };
 
@@ -152,7 +152,9 @@ int main(int argc, char** argv) {
       ++x->points;
       x->settle_sum_s += r.settle_s;
       x->unstable += r.unstable ? 1 : 0;
-      if (!r.pos_err_mean_deg) continue;
+      // The drive's lock guard ran the point on the encoder: its error fields are the encoder's.
+      x->lock_lost += r.lock_lost ? 1 : 0;
+      if (!r.pos_err_mean_deg || r.lock_lost) continue;
       const bool lost = *r.pos_err_max_deg - *r.pos_err_min_deg > 90.0;
       x->out_of_lock += lost ? 1 : 0;
       if (!lost) x->worst_in_lock_deg = std::max(x->worst_in_lock_deg, std::fabs(*r.pos_err_mean_deg));
@@ -161,12 +163,12 @@ int main(int argc, char** argv) {
       std::printf("%g rpm %g N m %g deg: pos %+.2f [%+.1f, %+.1f] deg, speed %.1f rpm, settle %.1f s%s\n",
                   r.speed_rpm, r.load_Nm, r.angle_deg, r.pos_err_mean_deg.value_or(NAN),
                   r.pos_err_min_deg.value_or(NAN), r.pos_err_max_deg.value_or(NAN), r.speed_meas_rpm,
-                  r.settle_s, r.unstable ? " UNSTABLE" : "");
+                  r.settle_s, r.unstable ? " UNSTABLE" : r.lock_lost ? " LOCK LOST" : "");
   }
   auto print = [](const char* what, const Tally& t) {
-    std::printf("%-8s %4d points, %3d unstable, %3d out of lock, worst |mean| in lock "
-                "%5.2f deg, mean settle %.1f s\n",
-                what, t.points, t.unstable, t.out_of_lock, t.worst_in_lock_deg,
+    std::printf("%-8s %4d points, %3d unstable, %3d lock lost, %3d out of lock, worst |mean| in "
+                "lock %5.2f deg, mean settle %.1f s\n",
+                what, t.points, t.unstable, t.lock_lost, t.out_of_lock, t.worst_in_lock_deg,
                 t.points ? t.settle_sum_s / t.points : 0.0);
   };
   std::printf("%s / %s, as a sweep\n", std::string(synbench::drivers::name(e)).c_str(),

@@ -1,7 +1,8 @@
 // Client-side stand-in for GET /api/sweeps/{id}/analysis while a daemon lacks the route: the same
 // JSON shape as bench::to_json(analysis) (docs/analysis.md) for the sections the dashboard draws,
 // computed from the points JSON with the same rules (parabola through the smallest sample and its
-// neighbours, edge minima not refined, unstable/faulted/voltage-limited points left out).
+// neighbours, edge minima not refined; unstable, faulted and voltage-limited points, those on a
+// low-speed fallback and those the lock guard ran on the encoder left out).
 const EST_ORDER = ['encoder', 'ekf-basic', 'ekf-rs', 'hfi', 'eemf-const', 'eemf-lut', 'eemf-rls'];
 const cfgKey = (r) => `${r.estimator}/${r.pwm}`;
 export const cfgSort = (a, b) => (EST_ORDER.indexOf(a.estimator) - EST_ORDER.indexOf(b.estimator))
@@ -61,6 +62,8 @@ export function analyzeClient(points, reference = { estimator: 'encoder', pwm: '
     if (r.unstable) reasons.push('unstable');
     if (r.fault) reasons.push('faulted');
     if (r.voltage_limited) reasons.push('voltage_limited');
+    if (r.below_min_speed) reasons.push('below_min_speed');
+    if (r.lock_lost) reasons.push('lock_lost');
     if (reasons.length) excluded.push({ record: k, estimator: r.estimator, pwm: r.pwm, speed_rpm: r.speed_rpm, load_Nm: r.load_Nm, angle_deg: r.angle_deg, reasons });
     else used.push(r);
   });
@@ -126,7 +129,8 @@ export function analyzeClient(points, reference = { estimator: 'encoder', pwm: '
   });
   return {
     schema: 'synbench.analysis/1', computed_by: 'dashboard',
-    options: { reference, exclude_unstable: true, exclude_faulted: true, exclude_voltage_limited: true },
+    options: { reference, exclude_unstable: true, exclude_faulted: true, exclude_voltage_limited: true,
+      exclude_below_min_speed: true, exclude_lock_lost: true },
     points: { records: points.length, used: used.length, excluded },
     curves: { thesis_figures: '6.20', entries: curves },
     deltas: { thesis_figures: '6.21', reference, entries: deltas },

@@ -106,7 +106,10 @@ function renderBenchPills(st) {
   const driveFault = [st.synrm?.fault, st.load?.fault].find((x) => x && x !== 'none');
   if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${trip.fault}`; f.title = trip.detail || ''; }
   else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
-  else if (st.synrm?.voltage_limited) { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
+  else if (st.synrm?.lock_lost) {
+    f.dataset.state = 'warn'; f.textContent = 'lock lost: on the encoder';
+    f.title = 'the estimator left the encoder angle; the drive runs on the encoder until the next setpoint';
+  } else if (st.synrm?.voltage_limited) { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
   else { f.dataset.state = 'ok'; f.textContent = 'no fault'; }
 }
 

@@ -15,7 +15,8 @@ struct EstimatorInput {
   std::optional<int> mcidc_phase;
   double mcidc_reluctance_per_H = 0;
   // The encoder's angle and speed: only for a handover to the encoder below an estimator's
-  // minimum speed (the thesis ran EEMF on the encoder there); estimators must not use them.
+  // minimum speed (the thesis ran EEMF on the encoder there) and for the drive's lock guard;
+  // estimators must not use them.
   double encoder_theta_e_rad = 0, encoder_omega_e_rad_s = 0;
 };
 
@@ -48,6 +49,10 @@ class Estimator {
   virtual bool on_fallback() const { return false; }
   // Takes over the given angle and speed (a handover from another position source).
   virtual void align(double /*theta_e_rad*/, double /*omega_e_rad_s*/) {}
+  // True while the drive's lock guard has taken the angle from the encoder (LockGuard); rearm()
+  // hands it back to the estimator at the next operating point.
+  virtual bool lock_lost() const { return false; }
+  virtual void rearm() {}
 };
 
 }  // namespace synbench::emulator::firmware

@@ -7,11 +7,13 @@
 #include "emulator/firmware/estimators/ekf_rs.hpp"
 #include "emulator/firmware/estimators/handover.hpp"
 #include "emulator/firmware/estimators/hfi.hpp"
+#include "emulator/firmware/estimators/lock_guard.hpp"
 
 namespace synbench::emulator::firmware {
 namespace {
 
-constexpr double kRadSPerRpm = 2.0 * 3.14159265358979323846 / 60.0;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadSPerRpm = 2.0 * kPi / 60.0;
 
 ShaftStiffnessParams stiffness(const TwinConfig& config) {
   ShaftStiffnessParams s;
@@ -64,9 +66,7 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
       w_hyst, p.ts_s);
 }
 
-}  // namespace
-
-EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config) {
+EstimatorChoice make_sensorless(drivers::Estimator kind, const TwinConfig& config) {
   EstimatorChoice c;
   const double ts = config.step_s();
   const double rs_threshold =
@@ -107,6 +107,19 @@ EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config
       return c;
   }
   c.error = make_error_code(errc::not_supported);
+  return c;
+}
+
+}  // namespace
+
+EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config) {
+  EstimatorChoice c = make_sensorless(kind, config);
+  const auto& f = config.firmware;
+  if (c.estimator && f.lock_guard_deg > 0) {
+    auto make = [kind, config] { return make_sensorless(kind, config).estimator; };
+    c.estimator = std::make_unique<LockGuard>(make, f.lock_guard_deg * kPi / 180.0, f.lock_guard_s,
+                                              f.lock_guard_current_A, config.step_s());
+  }
   return c;
 }
 

@@ -1,0 +1,78 @@
+// The drive's lock guard around a sensorless estimator.
+#include "emulator/firmware/estimators/lock_guard.hpp"
+
+#include <cmath>
+
+namespace synbench::emulator::firmware {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Within the guard angle this long before the angle guard arms [assumed].
+constexpr double kArm_s = 0.05;
+
+// Wrapped to (-pi/2, pi/2]: a SynRM's reluctance repeats every half electrical turn.
+double half_turn_error(double a) {
+  a = std::remainder(a, kPi);
+  return a <= -kPi / 2 ? a + kPi : a;
+}
+
+}  // namespace
+
+LockGuard::LockGuard(Factory make, double guard_rad, double guard_s, double guard_current_A,
+                     double ts_s)
+    : make_(std::move(make)), inner_(make_()), guard_rad_(guard_rad), guard_current_A_(guard_current_A),
+      guard_steps_(std::max(1L, std::lround(guard_s / ts_s))),
+      arm_steps_(std::max(1L, std::lround(kArm_s / ts_s))) {}
+
+void LockGuard::update(const EstimatorInput& in) {
+  enc_theta_ = in.encoder_theta_e_rad;
+  enc_omega_ = in.encoder_omega_e_rad_s;
+  if (tripped_) return;  // the lost estimator is replaced at the re-arm; nothing to feed
+  inner_->update(in);
+  const double err = half_turn_error(inner_->output().theta_e_rad - enc_theta_);
+  // Armed once the estimator has found the rotor on its own: an EKF converging from its thesis
+  // x0, HFI aligning after a start and an EEMF observer just taking over from its low-speed
+  // source on a speed ramp cross the guard angle on their way in, and recover.
+  const bool beyond = std::fabs(err) > guard_rad_;
+  if (!armed_) {
+    within_ = beyond || inner_->aligning() || inner_->on_fallback() ? 0 : within_ + 1;
+    armed_ = within_ >= arm_steps_;
+  }
+  beyond_ = armed_ && beyond ? beyond_ + 1 : 0;
+  // A current vector past the guard current is the other sign of a lost rotor: the frame turns
+  // against the back-EMF faster than the current loops follow (it precedes the over-current trip).
+  const bool surge = guard_current_A_ > 0 && std::hypot(in.ialpha_A, in.ibeta_A) > guard_current_A_;
+  if (beyond_ >= guard_steps_ || surge) tripped_ = true;
+}
+
+void LockGuard::injection(double& ud_V, double& uq_V) const {
+  if (tripped_) {
+    ud_V = uq_V = 0;
+    return;
+  }
+  inner_->injection(ud_V, uq_V);
+}
+
+void LockGuard::fundamental(double& id_A, double& iq_A) const {
+  if (!tripped_) inner_->fundamental(id_A, iq_A);
+}
+
+EstimatorOutput LockGuard::output() const {
+  EstimatorOutput o = inner_->output();
+  if (tripped_) {
+    o.theta_e_rad = enc_theta_;
+    o.omega_e_rad_s = enc_omega_;
+  }
+  return o;
+}
+
+void LockGuard::rearm() {
+  if (!tripped_) return;
+  inner_ = make_();
+  inner_->align(enc_theta_, enc_omega_);
+  tripped_ = false;
+  beyond_ = within_ = 0;
+  armed_ = false;
+}
+
+}  // namespace synbench::emulator::firmware
