@@ -108,7 +108,8 @@ struct FirmwareParams {
   double sensorless_angle_slew_deg_per_s = 30.0;
   // Lock guard (LockGuard): a sensorless angle off the encoder's by more than this, for this
   // long, hands the FOC to the encoder until the next operating point (0 deg: off).
-  double lock_guard_deg = 60.0;
+  double lock_guard_deg = 45.0;
+  double lock_guard_speed_rpm = 150.0;  // or a speed estimate this far off the encoder's (0: off)
   double lock_guard_s = 0.05;
   double lock_guard_current_A = 5.0;  // or a current vector this large (0: off)
   double telemetry_filter_s = 0.05;

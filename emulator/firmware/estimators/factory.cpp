@@ -117,8 +117,9 @@ EstimatorChoice make_estimator(drivers::Estimator kind, const TwinConfig& config
   const auto& f = config.firmware;
   if (c.estimator && f.lock_guard_deg > 0) {
     auto make = [kind, config] { return make_sensorless(kind, config).estimator; };
-    c.estimator = std::make_unique<LockGuard>(make, f.lock_guard_deg * kPi / 180.0, f.lock_guard_s,
-                                              f.lock_guard_current_A, config.step_s());
+    const double speed_rad_s = f.lock_guard_speed_rpm * kRadSPerRpm * config.synrm.pole_pairs;
+    c.estimator = std::make_unique<LockGuard>(make, f.lock_guard_deg * kPi / 180.0, speed_rad_s,
+                                              f.lock_guard_s, f.lock_guard_current_A, config.step_s());
   }
   return c;
 }

@@ -18,9 +18,10 @@ double half_turn_error(double a) {
 
 }  // namespace
 
-LockGuard::LockGuard(Factory make, double guard_rad, double guard_s, double guard_current_A,
-                     double ts_s)
-    : make_(std::move(make)), inner_(make_()), guard_rad_(guard_rad), guard_current_A_(guard_current_A),
+LockGuard::LockGuard(Factory make, double guard_rad, double guard_speed_rad_s, double guard_s,
+                     double guard_current_A, double ts_s)
+    : make_(std::move(make)), inner_(make_()), guard_rad_(guard_rad),
+      guard_speed_rad_s_(guard_speed_rad_s), guard_current_A_(guard_current_A),
       guard_steps_(std::max(1L, std::lround(guard_s / ts_s))),
       arm_steps_(std::max(1L, std::lround(kArm_s / ts_s))) {}
 
@@ -29,11 +30,13 @@ void LockGuard::update(const EstimatorInput& in) {
   enc_omega_ = in.encoder_omega_e_rad_s;
   if (tripped_) return;  // the lost estimator is replaced at the re-arm; nothing to feed
   inner_->update(in);
-  const double err = half_turn_error(inner_->output().theta_e_rad - enc_theta_);
+  const EstimatorOutput o = inner_->output();
+  const double err = half_turn_error(o.theta_e_rad - enc_theta_);
   // Armed once the estimator has found the rotor on its own: an EKF converging from its thesis
   // x0, HFI aligning after a start and an EEMF observer just taking over from its low-speed
   // source on a speed ramp cross the guard angle on their way in, and recover.
-  const bool beyond = std::fabs(err) > guard_rad_;
+  const bool beyond = std::fabs(err) > guard_rad_ ||
+                      (guard_speed_rad_s_ > 0 && std::fabs(o.omega_e_rad_s - enc_omega_) > guard_speed_rad_s_);
   if (!armed_) {
     within_ = beyond || inner_->aligning() || inner_->on_fallback() ? 0 : within_ + 1;
     armed_ = within_ >= arm_steps_;

@@ -2,8 +2,9 @@
 // estimator errors. Once a sensorless estimator has held within the guard angle of the encoder's
 // (wrapped to (-90, 90] deg, so a SynRM's harmless half-turn ambiguity passes) for 50 ms on its
 // own, the drive takes the angle and speed from the encoder when the estimate stays beyond the
-// guard angle for the guard time, or at once on a current surge, until the next operating point
-// is commanded, and reports it. Before it has held (an EKF converging from its initial state,
+// guard angle or its speed beyond the guard speed for the guard time, or at once on a current
+// surge, until the next operating point is commanded, and reports it. (An observer that slips
+// by whole turns shows the speed error while its wrapped angle error can stay under the guard.) Before it has held (an EKF converging from its initial state,
 // HFI aligning, an EEMF observer taking over on a speed ramp) only the surge counts: those cross
 // the angle on their way in and recover. An observer that slipped off the rotor otherwise
 // drives the current vector round a machine with ~170 V of back-EMF and trips on over-current,
@@ -23,7 +24,10 @@ namespace synbench::emulator::firmware {
 class LockGuard final : public Estimator {
  public:
   using Factory = std::function<std::unique_ptr<Estimator>()>;
-  LockGuard(Factory make, double guard_rad, double guard_s, double guard_current_A, double ts_s);
+  // guard_rad, guard_speed_rad_s (electrical; 0: no speed check) for guard_s; guard_current_A
+  // (0: no surge check).
+  LockGuard(Factory make, double guard_rad, double guard_speed_rad_s, double guard_s,
+            double guard_current_A, double ts_s);
   void update(const EstimatorInput& in) override;
   EstimatorOutput output() const override;
   void injection(double& ud_V, double& uq_V) const override;
@@ -37,7 +41,7 @@ class LockGuard final : public Estimator {
  private:
   Factory make_;
   std::unique_ptr<Estimator> inner_;
-  double guard_rad_, guard_current_A_;
+  double guard_rad_, guard_speed_rad_s_, guard_current_A_;
   long guard_steps_, arm_steps_;
   long beyond_ = 0;  // consecutive periods beyond the guard angle, once armed
   long within_ = 0;  // consecutive periods within it, before

@@ -1,6 +1,7 @@
 // The drive's lock guard around a scripted estimator: when it takes the angle from the estimator
-// (once armed, beyond the guard angle for the guard time, modulo a half turn, or on a current
-// surge), what it reports meanwhile, and the fresh estimator a re-arm starts.
+// (once armed, beyond the guard angle, modulo a half turn, or the guard speed for the guard
+// time, or on a current surge), what it reports meanwhile, and the fresh estimator a re-arm
+// starts.
 #include "emulator/firmware/estimators/lock_guard.hpp"
 
 #include <gtest/gtest.h>
@@ -15,7 +16,7 @@ constexpr double kDeg = kPi / 180.0;
 
 // Reports the encoder's angle plus a scripted offset, injects 7 V, remembers its alignment.
 struct Scripted final : Estimator {
-  double offset_rad = 0, theta = 0, aligned_to = NAN;
+  double offset_rad = 0, theta = 0, aligned_to = NAN, omega = 100.0;
   int updates = 0;
   void update(const EstimatorInput& in) override {
     ++updates;
@@ -24,7 +25,7 @@ struct Scripted final : Estimator {
   EstimatorOutput output() const override {
     EstimatorOutput o;
     o.theta_e_rad = theta;
-    o.omega_e_rad_s = 100.0;
+    o.omega_e_rad_s = omega;
     o.rs_ohm = 5.0;
     return o;
   }
@@ -39,7 +40,7 @@ struct Fixture {
                     made.push_back(e.get());
                     return e;
                   },
-                  45 * kDeg, 0.002, 5.0, 1e-4};
+                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
   EstimatorInput in;
   Fixture() {
     in.encoder_omega_e_rad_s = 90.0;
@@ -102,8 +103,9 @@ TEST(LockGuard, ArmsOnlyOnceTheEstimatorHasFoundTheRotor) {
                     made.push_back(e.get());
                     return e;
                   },
-                  45 * kDeg, 0.002, 5.0, 1e-4};
+                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
   EstimatorInput in;
+  in.encoder_omega_e_rad_s = 100.0;  // the scripted speed: only the angle is off
   made.back()->offset_rad = 80 * kDeg;
   for (int k = 0; k < 1000; ++k) guard.update(in);
   EXPECT_FALSE(guard.lock_lost()) << "not armed yet";
@@ -117,6 +119,19 @@ TEST(LockGuard, ArmsOnlyOnceTheEstimatorHasFoundTheRotor) {
   made.back()->offset_rad = 80 * kDeg;
   for (int k = 0; k < 20; ++k) guard.update(in);
   EXPECT_TRUE(guard.lock_lost());
+}
+
+TEST(LockGuard, ASpeedEstimateFarOffTheEncoderTripsItToo) {
+  // An observer slipping by whole turns: its wrapped angle error need not stay beyond the guard.
+  Fixture f;
+  f.made.back()->omega = 139.0;  // 49 rad/s off the encoder's 90
+  f.steps(1000, 10.0);
+  EXPECT_FALSE(f.guard.lock_lost());
+  f.made.back()->omega = 141.0;
+  f.steps(19, 10.0);
+  EXPECT_FALSE(f.guard.lock_lost());
+  f.steps(1, 10.0);
+  EXPECT_TRUE(f.guard.lock_lost());
 }
 
 TEST(LockGuard, ACurrentSurgeTripsItAtOnce) {
