@@ -134,7 +134,8 @@ void SweepEngine::finish_point(double /*now_s*/) {
     // Not a fault: the estimator's limit at this point. The drive's lock guard already runs on
     // the encoder and hands back at the next point's setpoints.
     sink_.event("log", "point " + std::to_string(n.point.index) +
-                           ": the estimator lost the rotor; the drive's lock guard ran the point on the encoder");
+                           ": the estimator lost the rotor; the drive's lock guard ran the point "
+                           "on the encoder");
   }
   if (proc->speed_lost()) {
     // The drive lost the speed (a sensorless observer that slipped off the rotor does not find

@@ -32,11 +32,12 @@ void LockGuard::update(const EstimatorInput& in) {
   inner_->update(in);
   const EstimatorOutput o = inner_->output();
   const double err = half_turn_error(o.theta_e_rad - enc_theta_);
+  const double speed_err = std::fabs(o.omega_e_rad_s - enc_omega_);
+  const bool beyond =
+      std::fabs(err) > guard_rad_ || (guard_speed_rad_s_ > 0 && speed_err > guard_speed_rad_s_);
   // Armed once the estimator has found the rotor on its own: an EKF converging from its thesis
   // x0, HFI aligning after a start and an EEMF observer just taking over from its low-speed
-  // source on a speed ramp cross the guard angle on their way in, and recover.
-  const bool beyond = std::fabs(err) > guard_rad_ ||
-                      (guard_speed_rad_s_ > 0 && std::fabs(o.omega_e_rad_s - enc_omega_) > guard_speed_rad_s_);
+  // source on a speed ramp cross the guard on their way in, and recover.
   if (!armed_) {
     within_ = beyond || inner_->aligning() || inner_->on_fallback() ? 0 : within_ + 1;
     armed_ = within_ >= arm_steps_;

@@ -1,17 +1,18 @@
 // Lock guard [ours]: the bench has the encoder on the shaft anyway, as the reference for the
 // estimator errors. Once a sensorless estimator has held within the guard angle of the encoder's
 // (wrapped to (-90, 90] deg, so a SynRM's harmless half-turn ambiguity passes) for 50 ms on its
-// own, the drive takes the angle and speed from the encoder when the estimate stays beyond the
-// guard angle or its speed beyond the guard speed for the guard time, or at once on a current
-// surge, until the next operating point is commanded, and reports it. (An observer that slips
-// by whole turns shows the speed error while its wrapped angle error can stay under the guard.) Before it has held (an EKF converging from its initial state,
-// HFI aligning, an EEMF observer taking over on a speed ramp) only the surge counts: those cross
-// the angle on their way in and recover. An observer that slipped off the rotor otherwise
-// drives the current vector round a machine with ~170 V of back-EMF and trips on over-current,
-// which latches and ends an unattended sweep; guarded, the point is flagged `lock_lost` and the
-// sweep goes on (docs/estimators.md). Re-arming starts a fresh estimator, as an enable does,
-// aligned to the encoder: what the lost one had learnt (an RLS memory, a tracking state) is what
-// lost the rotor. While the guard holds, the lost estimator is neither fed nor injects.
+// own, the drive takes the angle and speed from the encoder when the estimated angle stays
+// beyond the guard angle, or the estimated speed beyond the guard speed (an observer slipping by
+// whole turns, whose wrapped angle error need not stay beyond), for the guard time, or at once
+// on a current surge; until the next operating point is commanded, and reports it. Before it has
+// held (an EKF converging from its initial state, HFI aligning, an EEMF observer taking over on
+// a speed ramp) only the surge counts: those cross the guard on their way in and recover.
+// A slipped observer otherwise drives the current vector round a machine with ~170 V of
+// back-EMF and trips on over-current (or runs away into over-speed), which latches and ends an
+// unattended sweep; guarded, the point is flagged `lock_lost` and the sweep goes on
+// (docs/estimators.md). Re-arming starts a fresh estimator, as an enable does, aligned to the
+// encoder: what the lost one had learnt (an RLS memory, a tracking state) is what lost the
+// rotor. While the guard holds, the lost estimator is neither fed nor injects.
 #pragma once
 
 #include <functional>
@@ -34,7 +35,9 @@ class LockGuard final : public Estimator {
   void fundamental(double& id_A, double& iq_A) const override;
   bool aligning() const override { return !tripped_ && inner_->aligning(); }
   bool on_fallback() const override { return !tripped_ && inner_->on_fallback(); }
-  void align(double theta_e_rad, double omega_e_rad_s) override { inner_->align(theta_e_rad, omega_e_rad_s); }
+  void align(double theta_e_rad, double omega_e_rad_s) override {
+    inner_->align(theta_e_rad, omega_e_rad_s);
+  }
   bool lock_lost() const override { return tripped_; }
   void rearm() override;
 
