@@ -31,7 +31,7 @@ struct SynrmTelemetry {
   // period; empty when the encoder is the position source.
   std::optional<double> pos_err_deg;
   // The drive's lock guard took the angle from a sensorless estimator that left the encoder's
-  // (a slipped observer) and runs on the encoder until the next operating point is commanded.
+  // (a slipped observer) and runs on the encoder until the speed or angle setpoint changes.
   bool lock_lost = false;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;

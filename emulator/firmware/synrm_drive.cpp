@@ -91,22 +91,25 @@ std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
   if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!std::isfinite(speed_rpm) || std::fabs(speed_rpm) > cfg_.firmware.max_speed_rpm)
     return make_error_code(errc::invalid_argument);
+  if (speed_rpm != speed_set_rpm_) rearm_guard();
   speed_set_rpm_ = speed_rpm;
-  rearm_guard();
   return {};
 }
 
 std::error_code SynrmDriveFirmware::set_angle_deg(double angle_deg) {
   if (!std::isfinite(angle_deg) || angle_deg <= 0.0 || angle_deg >= 90.0)
     return make_error_code(errc::invalid_argument);
-  angle_set_rad_ = angle_deg * kPi / 180.0;
+  const double angle_rad = angle_deg * kPi / 180.0;
+  if (angle_rad != angle_set_rad_) rearm_guard();
+  angle_set_rad_ = angle_rad;
   if (state_ != drivers::DriveState::running) angle_rad_ = angle_set_rad_;
-  rearm_guard();
   return {};
 }
 
 void SynrmDriveFirmware::rearm_guard() {
-  // A new operating point hands the angle back to the estimator after a lock guard trip.
+  // A new operating point hands the angle back to the estimator after a lock guard trip. Only a
+  // changed setpoint is one: an ordered stop writes zero speed every tick, and re-arming there
+  // would hand a lost drive a fresh estimator every 10 ms while it decelerates.
   if (estimator_) estimator_->rearm();
 }
 

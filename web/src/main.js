@@ -108,7 +108,7 @@ function renderBenchPills(st) {
   else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
   else if (st.synrm?.lock_lost) {
     f.dataset.state = 'warn'; f.textContent = 'lock lost: on the encoder';
-    f.title = 'the estimator left the encoder angle; the drive runs on the encoder until the next setpoint';
+    f.title = 'the estimator left the encoder angle; the drive runs on the encoder until the speed or angle setpoint changes';
   } else if (st.synrm?.voltage_limited) { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
   else { f.dataset.state = 'ok'; f.textContent = 'no fault'; }
 }

@@ -4,7 +4,7 @@
 // own, the drive takes the angle and speed from the encoder when the estimated angle stays
 // beyond the guard angle, or the estimated speed beyond the guard speed (an observer slipping by
 // whole turns, whose wrapped angle error need not stay beyond), for the guard time, or at once
-// on a current surge; until the next operating point is commanded, and reports it. Before it has
+// on a current surge; until the speed or angle setpoint changes, and reports it. Before it has
 // held (an EKF converging from its initial state, HFI aligning, an EEMF observer taking over on
 // a speed ramp) only the surge counts: those cross the guard on their way in and recover.
 // A slipped observer otherwise drives the current vector round a machine with ~170 V of
