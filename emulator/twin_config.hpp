@@ -145,6 +145,7 @@ struct EemfConfig {
   double rls_forgetting = 0.99;
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;
+  double rls_estimate_filter_s = 0.2;  // low-pass on the estimates the observer uses
   double prbs_voltage_V = 20.0;
   double prbs_bit_s = 0.01;
 };
