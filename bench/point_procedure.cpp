@@ -122,7 +122,12 @@ void PointProcedure::tick(double now_s) {
       if (!check(dev_.load->enable(true), "enabling the load drive")) return;
       if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
       if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
-      if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+      sensorless_start_ = req_.estimator != drivers::Estimator::encoder;
+      angle_pending_ = sensorless_start_ && opt_.sensorless_start_angle_deg > 0 &&
+                       req_.angle_deg > opt_.sensorless_start_angle_deg;
+      if (!check(dev_.synrm->set_angle_deg(angle_pending_ ? opt_.sensorless_start_angle_deg : req_.angle_deg),
+                 "setting the current angle"))
+        return;
       if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
       if (!check(dev_.synrm->enable(true), "enabling the SynRM drive")) return;
       enter(PointPhase::spin_up, now_s);
@@ -130,6 +135,9 @@ void PointProcedure::tick(double now_s) {
     }
     case PointPhase::spin_up: {
       const bool reached = std::fabs(st.speed_rpm - req_.speed_rpm) < opt_.speed_reached_band_rpm;
+      if (sensorless_start_ && !load_pending_ &&
+          std::fabs(st.speed_rpm) >= opt_.sensorless_load_at_speed_fraction * std::fabs(req_.speed_rpm))
+        command_load(req_.load_Nm);
       if (reached || now_s - t_phase_ > opt_.spin_up_timeout_s) {
         if (!reached) record_.unstable = true;
         command_load(req_.load_Nm);
@@ -140,6 +148,13 @@ void PointProcedure::tick(double now_s) {
     case PointPhase::load_up: {
       if (std::fabs(lt.torque_Nm - req_.load_Nm) < 0.02 * req_.load_Nm + 0.02 ||
           now_s - t_phase_ > opt_.spin_up_timeout_s) {
+        if (angle_pending_) {
+          // The point's own angle. A lock the guard lost on the way belongs to the start: the new
+          // angle setpoint hands the rotor to a fresh estimator, and the point is judged from here.
+          if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+          angle_pending_ = false;
+          record_.lock_lost = false;
+        }
         gate_.reset();
         enter(PointPhase::settle, now_s);
       }

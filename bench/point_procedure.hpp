@@ -43,6 +43,16 @@ struct PointOptions {
   // 2.5 N m step (ramped by the load drive within 0.25 s) stalled EEMF-LUT at 700 rpm, 56 deg
   // (a PI tracking loop lags an acceleration alpha by alpha / wn^2), 2 N m/s did not.
   double load_ramp_Nm_per_s = 2.0;
+  // A sensorless point started from rest [ours] spins up and takes its load at no more than
+  // `sensorless_start_angle_deg`, moving to its own angle once loaded (0: its own from the
+  // start), and its load comes from `sensorless_load_at_speed_fraction` of the speed on instead
+  // of once the speed is reached. Unloaded, the spin-up's speed overshoot takes the current down
+  // to a few hundred mA: an EEMF, proportional to i_d, is then a few volts, and EEMF-CONST
+  // slipped at every load at 700 rpm, 58 deg and at 500 rpm, 40 deg, long before the load came.
+  // At 45 deg the EEMF is larger and the shaft (below the MTPA angle) steadies the angle error,
+  // and loaded the observer holds the move up (docs/estimators.md). Chained points keep theirs.
+  double sensorless_start_angle_deg = 45.0;
+  double sensorless_load_at_speed_fraction = 0.8;
   // A drive that cannot hold the commanded speed while settling (a sensorless observer that lost
   // the rotor: the shaft stalls while the estimate spins on) is measured at once, flagged
   // unstable and reported by speed_lost(), instead of waiting out the gate's timeout (a sweep
@@ -100,6 +110,8 @@ class PointProcedure {
   LoadRamp load_ramp_;
   double t_last_tick_ = -1;
   bool load_pending_ = false;
+  bool sensorless_start_ = false;  // a sensorless estimator, started from rest
+  bool angle_pending_ = false;     // spun up at the sensorless start angle; its own comes when loaded
   PointRecord record_;
   std::string error_;
 };

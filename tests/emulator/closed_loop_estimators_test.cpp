@@ -140,6 +140,9 @@ TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
   EXPECT_EQ(ekf.in_lock, ekf.points);
   // Enough points in lock for the means to say something.
   for (const auto& r : {konst, lut, lut_lq}) EXPECT_GE(r.in_lock, 6);
+  // Spun up and loaded at 45 deg before the point's own angle (PointOptions), EEMF-CONST holds
+  // every point here (7 of 12 when each spun up at its own angle).
+  EXPECT_GE(konst.in_lock, 11);
   EXPECT_GT(konst.mean_abs_in_lock_deg, lut.mean_abs_in_lock_deg + 2.0);
   EXPECT_GT(konst.mean_abs_in_lock_deg, ekf.mean_abs_in_lock_deg);
   EXPECT_LT(lut.mean_abs_in_lock_deg, 2.0);
