@@ -90,8 +90,11 @@ void PointProcedure::tick(double now_s) {
       return;
     }
     if (!ramp_load(now_s) && phase_ != PointPhase::stop) return;
-    // Until the window closes: the guard hands back only at the next point's setpoints.
-    if (st.lock_lost && phase_ != PointPhase::stop) record_.lock_lost = true;
+    // Until the window closes. A trip the drive still holds from the previous point (its guard
+    // hands back once the new setpoints are reached) is not this point's: only a trip after the
+    // drive was seen in lock, or one still held when the window opens, counts.
+    if (!st.lock_lost) lock_seen_ = true;
+    if (st.lock_lost && lock_seen_ && phase_ != PointPhase::stop) record_.lock_lost = true;
   }
 
   switch (phase_) {
@@ -154,6 +157,7 @@ void PointProcedure::tick(double now_s) {
           if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
           angle_pending_ = false;
           record_.lock_lost = false;
+          lock_seen_ = false;
         }
         gate_.reset();
         enter(PointPhase::settle, now_s);

@@ -112,6 +112,7 @@ class PointProcedure {
   bool load_pending_ = false;
   bool sensorless_start_ = false;  // a sensorless estimator, started from rest
   bool angle_pending_ = false;     // spun up at the sensorless start angle; its own comes when loaded
+  bool lock_seen_ = false;         // the drive's lock guard was seen not tripped during this point
   PointRecord record_;
   std::string error_;
 };

@@ -31,7 +31,8 @@ struct SynrmTelemetry {
   // period; empty when the encoder is the position source.
   std::optional<double> pos_err_deg;
   // The drive's lock guard took the angle from a sensorless estimator that left the encoder's
-  // (a slipped observer) and runs on the encoder until the speed or angle setpoint changes.
+  // (a slipped observer) and runs on the encoder until a changed speed or angle setpoint is
+  // reached.
   bool lock_lost = false;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;

@@ -46,7 +46,7 @@ constexpr SignalSpec kSynrm[] = {
     {"temp_C", R::telemetry, false, "C", "power-stage temperature"},
     {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
     {"pos_err_deg", R::telemetry, false, "deg", "estimated minus encoder angle, last control period; not with the encoder"},
-    {"lock_lost", R::telemetry, false, "", "1 while the lock guard runs a sensorless drive on the encoder (until the speed or angle setpoint changes)"},
+    {"lock_lost", R::telemetry, false, "", "1 while the lock guard runs a sensorless drive on the encoder (until a changed speed or angle setpoint is reached)"},
     {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
     {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, true, "", "control periods accumulated"},

@@ -109,8 +109,9 @@ std::error_code SynrmDriveFirmware::set_angle_deg(double angle_deg) {
 void SynrmDriveFirmware::rearm_guard() {
   // A new operating point hands the angle back to the estimator after a lock guard trip. Only a
   // changed setpoint is one: an ordered stop writes zero speed every tick, and re-arming there
-  // would hand a lost drive a fresh estimator every 10 ms while it decelerates.
-  if (estimator_) estimator_->rearm();
+  // would hand a lost drive a fresh estimator every 10 ms while it decelerates. The hand-over
+  // waits until the speed and angle references have reached the new setpoints (control()).
+  rearm_pending_ = true;
 }
 
 std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {
@@ -263,6 +264,13 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       angle_rad_ += std::clamp(angle_set_rad_ - angle_rad_, -slew_rad, slew_rad);
     else
       angle_rad_ = angle_set_rad_;
+    if (rearm_pending_ && angle_rad_ == angle_set_rad_ && speed_ref_rpm_ == speed_set_rpm_) {
+      // The new point's own angle and speed, not the old one's: a fresh estimator handed the
+      // rotor at once after a lost 76 deg point met the next point's 40 deg with the current
+      // still at 76 deg, where the shaft makes any angle error grow, and lost it again.
+      if (estimator_) estimator_->rearm();
+      rearm_pending_ = false;
+    }
     // Motoring and braking both keep i_d positive; the sign of I_m goes to i_q (torque sign).
     const double id_ref = std::fabs(im_req_A_) * std::cos(angle_rad_);
     const double iq_ref = im_req_A_ * std::sin(angle_rad_);

@@ -95,6 +95,7 @@ class SynrmDriveFirmware {
   drivers::Fault pending_fault_ = drivers::Fault::none;  // latched when the ordered stop ends
   drivers::Pwm pwm_;
   double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0, angle_set_rad_ = 0.0;
+  bool rearm_pending_ = false;  // a changed setpoint re-arms the lock guard once reached
   std::uint64_t step_ = 0;
 
   // Position source: the selected estimator, or the encoder when null.

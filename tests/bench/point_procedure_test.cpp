@@ -278,3 +278,37 @@ TEST(PointProcedure, TheSensorlessStartKeepsEemfConstInLock) {
 
 }  // namespace
 }  // namespace synbench::bench
+
+namespace synbench::bench {
+namespace {
+
+// Chained as a sweep runs them: a point the drive's lock guard took to the encoder (EEMF-LUT at
+// 500 rpm, 2 N m, 76 deg) and the next one (2.5 N m, 40 deg). The drive holds the trip until
+// the new setpoints are reached; that held trip is not the next point's, which is measured in
+// lock on the fresh estimator.
+TEST(PointProcedure, ATripHeldFromThePreviousPointIsNotTheNextPointsLockLoss) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  PointOptions opt;
+  opt.ordered_stop_after = false;
+  opt.continue_running = true;
+  opt.settle_timeout_s = 5.0;
+  const auto chained = [&](double load_Nm, double angle_deg) {
+    PointRequest req = request(500, load_Nm, angle_deg);
+    req.estimator = drivers::Estimator::eemf_lut;
+    const auto p = run_point(bench.devices(), bench.clock(), req, opt);
+    EXPECT_TRUE(p.has_record()) << p.error();
+    return p.record();
+  };
+  const auto before = chained(2.0, 56.0);
+  const auto lost = chained(2.0, 76.0);
+  const auto next = chained(2.5, 40.0);
+  EXPECT_FALSE(before.lock_lost);
+  ASSERT_TRUE(lost.lock_lost) << "EEMF-LUT held 76 deg: the test needs a lost point";
+  EXPECT_FALSE(next.lock_lost);
+  EXPECT_FALSE(next.fault);
+  ASSERT_TRUE(next.pos_err_mean_deg);
+  EXPECT_LT(std::fabs(*next.pos_err_mean_deg), 2.0);
+}
+
+}  // namespace
+}  // namespace synbench::bench

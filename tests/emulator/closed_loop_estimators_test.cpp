@@ -327,3 +327,54 @@ TEST(ClosedLoopEstimators, HfiHoldsChainedLoadAndAngleSteps) {
 
 }  // namespace
 }  // namespace synbench
+
+namespace synbench {
+namespace {
+
+// After a lost point the drive's lock guard hands the rotor back to a fresh estimator once the
+// next point's setpoints are reached, not when they are written: written, the current was still
+// at the lost point's 76 deg, where the shaft makes any angle error grow, and the fresh EEMF-LUT
+// lost the rotor again at the next 40 deg point of every load in the thesis sweep.
+TEST(ClosedLoopEstimators, TheLockGuardHandsBackOnceTheNewSetpointsAreReached) {
+  emulator::Twin tw{emulator::TwinConfig{}};
+  auto& d = tw.synrm_drive();
+  ASSERT_FALSE(d.set_pwm(drivers::Pwm::capwm));
+  ASSERT_FALSE(d.set_estimator(drivers::Estimator::eemf_lut));
+  ASSERT_FALSE(d.set_angle_deg(45));
+  ASSERT_FALSE(d.set_speed_rpm(500));
+  ASSERT_FALSE(d.enable(true));
+  ASSERT_FALSE(tw.load_drive().enable(true));
+  const auto run_s = [&](double s) { tw.run_steps(static_cast<std::int64_t>(std::lround(s / 1e-4))); };
+  run_s(1.5);
+  for (int i = 1; i <= 10; ++i) {  // 2 N m at 2 N m/s, as the bench ramps it
+    ASSERT_FALSE(tw.load_drive().set_torque_Nm(0.2 * i));
+    run_s(0.1);
+  }
+  run_s(1.0);
+  ASSERT_FALSE(d.telemetry().lock_lost) << "in lock at 45 deg";
+  ASSERT_FALSE(d.set_angle_deg(76));
+  bool lost = false;
+  for (int i = 0; i < 500 && !lost; ++i) {
+    run_s(0.01);
+    lost = d.telemetry().lock_lost;
+  }
+  ASSERT_TRUE(lost) << "EEMF-LUT holds 500 rpm, 2 N m, 76 deg: the test needs a lost point";
+  run_s(0.5);
+  ASSERT_FALSE(d.set_angle_deg(40));  // 36 deg at 30 deg/s: 1.2 s of slewing
+  run_s(1.0);
+  EXPECT_TRUE(d.telemetry().lock_lost) << "handed back before the angle reached 40 deg";
+  run_s(0.4);
+  EXPECT_FALSE(d.telemetry().lock_lost) << "not handed back at 40 deg";
+  double worst = 0;
+  for (int i = 0; i < 200; ++i) {
+    run_s(0.01);
+    const auto t = d.telemetry();
+    EXPECT_FALSE(t.lock_lost) << "lost again at 40 deg";
+    if (t.pos_err_deg) worst = std::max(worst, std::fabs(*t.pos_err_deg));
+  }
+  EXPECT_EQ(d.fault(), drivers::Fault::none);
+  EXPECT_LT(worst, 10.0);
+}
+
+}  // namespace
+}  // namespace synbench
