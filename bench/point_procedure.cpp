@@ -138,9 +138,11 @@ void PointProcedure::tick(double now_s) {
     }
     case PointPhase::spin_up: {
       const bool reached = std::fabs(st.speed_rpm - req_.speed_rpm) < opt_.speed_reached_band_rpm;
-      if (sensorless_start_ && !load_pending_ &&
-          std::fabs(st.speed_rpm) >= opt_.sensorless_load_at_speed_fraction * std::fabs(req_.speed_rpm))
+      if (sensorless_start_ && !early_load_ &&
+          std::fabs(st.speed_rpm) >= opt_.sensorless_load_at_speed_fraction * std::fabs(req_.speed_rpm)) {
         command_load(req_.load_Nm);
+        early_load_ = true;
+      }
       if (reached || now_s - t_phase_ > opt_.spin_up_timeout_s) {
         if (!reached) record_.unstable = true;
         command_load(req_.load_Nm);

@@ -111,6 +111,7 @@ class PointProcedure {
   double t_last_tick_ = -1;
   bool load_pending_ = false;
   bool sensorless_start_ = false;  // a sensorless estimator, started from rest
+  bool early_load_ = false;        // its load commanded before the speed was reached
   bool angle_pending_ = false;     // spun up at the sensorless start angle; its own comes when loaded
   bool lock_seen_ = false;         // the drive's lock guard was seen not tripped during this point
   PointRecord record_;

@@ -149,7 +149,7 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.num("firmware.lock_guard_deg", &f.lock_guard_deg, 0, 90, "assumed",
         "lock guard: estimated minus encoder angle beyond which the encoder takes over until the next point (0: off)", A);
   b.num("firmware.lock_guard_speed_rpm", &f.lock_guard_speed_rpm, 0, 10000, "assumed",
-        "lock guard: or estimated minus encoder speed beyond this (0: off)", A);
+        "lock guard: or estimated minus encoder speed beyond this (before the estimator has held: for 0.2 s) (0: off)", A);
   b.num("firmware.lock_guard_s", &f.lock_guard_s, 0, 1, "assumed", "lock guard: how long the angle or speed must stay beyond it", A);
   b.num("firmware.lock_guard_current_A", &f.lock_guard_current_A, 0, 100, "assumed",
         "lock guard: or a current vector above this, sensorless (0: off)", A);

@@ -80,6 +80,7 @@ std::error_code SynrmDriveFirmware::enable(bool on) {
   // were off it saw no current and drifted. (An EEMF observer then starts on its low-speed source,
   // which hands over at once, aligned, when the shaft still turns above the minimum speed.)
   if (estimator_) estimator_ = make_estimator(estimator_kind_, cfg_).estimator;
+  rearm_pending_ = false;
   speed_ref_rpm_ = obs_omega_ * kRpmPerRadS;
   speed_pi_.reset();
   id_pi_.reset();
@@ -110,8 +111,9 @@ void SynrmDriveFirmware::rearm_guard() {
   // A new operating point hands the angle back to the estimator after a lock guard trip. Only a
   // changed setpoint is one: an ordered stop writes zero speed every tick, and re-arming there
   // would hand a lost drive a fresh estimator every 10 ms while it decelerates. The hand-over
-  // waits until the speed and angle references have reached the new setpoints (control()).
-  rearm_pending_ = true;
+  // waits until the speed and angle references have reached the new setpoints (control()), and
+  // concerns a trip held now: one on the way there is the new point's, held to the next.
+  if (estimator_ && estimator_->lock_lost()) rearm_pending_ = true;
 }
 
 std::error_code SynrmDriveFirmware::set_pwm(drivers::Pwm pwm) {

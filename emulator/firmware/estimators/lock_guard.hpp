@@ -46,9 +46,10 @@ class LockGuard final : public Estimator {
   Factory make_;
   std::unique_ptr<Estimator> inner_;
   double guard_rad_, guard_speed_rad_s_, guard_current_A_;
-  long guard_steps_, arm_steps_;
+  long guard_steps_, arm_steps_, unfound_steps_;
   long beyond_ = 0;  // consecutive periods beyond the guard angle, once armed
   long within_ = 0;  // consecutive periods within it, before
+  long unfound_ = 0;  // consecutive periods off the encoder's speed, before
   bool armed_ = false;
   bool tripped_ = false;
   double enc_theta_ = 0, enc_omega_ = 0;

@@ -1,12 +1,14 @@
 // The drive's lock guard around a scripted estimator: when it takes the angle from the estimator
 // (once armed, beyond the guard angle, modulo a half turn, or the guard speed for the guard
-// time, or on a current surge), what it reports meanwhile, and the fresh estimator a re-arm
-// starts.
+// time; before, off the guard speed for 0.2 s; or on a current surge), what it reports
+// meanwhile, and the fresh estimator a re-arm starts.
 #include "emulator/firmware/estimators/lock_guard.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
 namespace synbench::emulator::firmware {
 namespace {
@@ -119,6 +121,30 @@ TEST(LockGuard, ArmsOnlyOnceTheEstimatorHasFoundTheRotor) {
   made.back()->offset_rad = 80 * kDeg;
   for (int k = 0; k < 20; ++k) guard.update(in);
   EXPECT_TRUE(guard.lock_lost());
+}
+
+TEST(LockGuard, OneThatNeverFindsTheRotorTripsOnItsSpeedAfter200Ms) {
+  // Not armed (its angle never held), but its speed stays off the encoder's: a fresh observer
+  // that never found the rotor while the shaft runs away. One converging inside 0.2 s does not.
+  std::vector<Scripted*> made;
+  LockGuard guard{[&] {
+                    auto e = std::make_unique<Scripted>();
+                    made.push_back(e.get());
+                    return e;
+                  },
+                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+  EstimatorInput in;
+  in.encoder_omega_e_rad_s = 200.0;  // the scripted 100 rad/s is 100 off
+  made.back()->offset_rad = 80 * kDeg;
+  for (int k = 0; k < 1999; ++k) guard.update(in);
+  EXPECT_FALSE(guard.lock_lost()) << "199.9 ms";
+  made.back()->omega = 200.0;  // found the speed in time
+  for (int k = 0; k < 10; ++k) guard.update(in);
+  made.back()->omega = 100.0;
+  for (int k = 0; k < 1999; ++k) guard.update(in);
+  EXPECT_FALSE(guard.lock_lost()) << "the count starts again";
+  guard.update(in);
+  EXPECT_TRUE(guard.lock_lost()) << "0.2 s off the encoder's speed without ever holding";
 }
 
 TEST(LockGuard, ASpeedEstimateFarOffTheEncoderTripsItToo) {
