@@ -151,6 +151,16 @@ TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
   // 0.16 deg in lock); what a wrong Ld does is the next test's.
 }
 
+// Points chained as a sweep runs them: the drives keep running between points.
+bench::PointOptions chained_options(const emulator::TwinConfig& cfg) {
+  bench::PointOptions opt;
+  opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
+  opt.ordered_stop_after = false;
+  opt.continue_running = true;
+  opt.settle_timeout_s = 5.0;
+  return opt;
+}
+
 struct ChainedLock {
   int lost = 0, points = 0;
   double worst_abs_in_lock_deg = 0;
@@ -162,11 +172,7 @@ ChainedLock chained_lut_700(double ld_scale) {
   emulator::TwinConfig cfg;
   cfg.estimators.eemf.lut_ld_scale = ld_scale;
   emulator::TwinBench bench(cfg);
-  bench::PointOptions opt;
-  opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
-  opt.ordered_stop_after = false;
-  opt.continue_running = true;
-  opt.settle_timeout_s = 5.0;
+  const auto opt = chained_options(cfg);
   ChainedLock out;
   for (double load : {1.0, 1.5, 2.0, 2.5, 3.0, 3.5})
     for (double angle : {52.0, 56.0, 58.0, 60.0, 62.0}) {
@@ -261,11 +267,7 @@ TEST(ClosedLoopEstimators, EemfHoldsAChainedSequenceOfPoints) {
   for (const Case c : {Case{drivers::Estimator::eemf_const, 15.0}, Case{drivers::Estimator::eemf_lut, 6.0}}) {
     emulator::TwinConfig cfg;
     emulator::TwinBench bench(cfg);
-    bench::PointOptions opt;
-    opt.load_b1_Nms_per_rad = cfg.load.b1_Nms_per_rad;
-    opt.ordered_stop_after = false;
-    opt.continue_running = true;
-    opt.settle_timeout_s = 5.0;
+    const auto opt = chained_options(cfg);
     for (double load : {0.5, 2.0, 3.5})
       for (double angle : {40.0, 45.0, 50.0, 55.0, 60.0}) {
         bench::PointRequest req;

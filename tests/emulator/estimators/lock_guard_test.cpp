@@ -35,14 +35,20 @@ struct Scripted final : Estimator {
   void align(double theta_e_rad, double) override { aligned_to = theta_e_rad; }
 };
 
+// A guard with the thesis-like settings (45 deg, 50 rad/s, 2 ms, 5 A) that records the
+// estimators it makes.
+LockGuard make_guard(std::vector<Scripted*>& made) {
+  return LockGuard{[&made] {
+                     auto e = std::make_unique<Scripted>();
+                     made.push_back(e.get());
+                     return e;
+                   },
+                   45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+}
+
 struct Fixture {
   std::vector<Scripted*> made;
-  LockGuard guard{[this] {
-                    auto e = std::make_unique<Scripted>();
-                    made.push_back(e.get());
-                    return e;
-                  },
-                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+  LockGuard guard = make_guard(made);
   EstimatorInput in;
   Fixture() {
     in.encoder_omega_e_rad_s = 90.0;
@@ -100,12 +106,7 @@ TEST(LockGuard, TakesTheEncoderAfterTheGuardTimeUntilRearmedWithAFreshEstimator)
 TEST(LockGuard, ArmsOnlyOnceTheEstimatorHasFoundTheRotor) {
   // An estimator converging from its initial state crosses the guard angle on its way in.
   std::vector<Scripted*> made;
-  LockGuard guard{[&] {
-                    auto e = std::make_unique<Scripted>();
-                    made.push_back(e.get());
-                    return e;
-                  },
-                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+  LockGuard guard = make_guard(made);
   EstimatorInput in;
   in.encoder_omega_e_rad_s = 100.0;  // the scripted speed: only the angle is off
   made.back()->offset_rad = 80 * kDeg;
@@ -127,12 +128,7 @@ TEST(LockGuard, OneThatNeverFindsTheRotorTripsOnItsSpeedAfter200Ms) {
   // Not armed (its angle never held), but its speed stays off the encoder's: a fresh observer
   // that never found the rotor while the shaft runs away. One converging inside 0.2 s does not.
   std::vector<Scripted*> made;
-  LockGuard guard{[&] {
-                    auto e = std::make_unique<Scripted>();
-                    made.push_back(e.get());
-                    return e;
-                  },
-                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+  LockGuard guard = make_guard(made);
   EstimatorInput in;
   in.encoder_omega_e_rad_s = 200.0;  // the scripted 100 rad/s is 100 off
   made.back()->offset_rad = 80 * kDeg;
