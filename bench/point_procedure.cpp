@@ -145,7 +145,7 @@ void PointProcedure::tick(double now_s) {
       }
       if (reached || now_s - t_phase_ > opt_.spin_up_timeout_s) {
         if (!reached) record_.unstable = true;
-        command_load(req_.load_Nm);
+        if (!early_load_) command_load(req_.load_Nm);
         enter(PointPhase::load_up, now_s);
       }
       return;

@@ -22,12 +22,8 @@ double wrap_pi(double x) {
   return x - kPi;
 }
 
-// A SynRM is symmetric under 180 electrical degrees: a position error in rad as deg in (-90, 90].
-double wrap_half_turn_deg(double err_rad) {
-  double e = std::remainder(err_rad, kPi) * 180.0 / kPi;
-  if (e <= -90.0) e += 180.0;
-  return e;
-}
+// A position error in rad as deg in (-90, 90] (half_turn_error_rad).
+double wrap_half_turn_deg(double err_rad) { return half_turn_error_rad(err_rad) * 180.0 / kPi; }
 
 }  // namespace
 

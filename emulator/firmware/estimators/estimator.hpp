@@ -3,9 +3,18 @@
 // the selected estimator's angle and speed then drive the FOC (the encoder is only the reference).
 #pragma once
 
+#include <cmath>
 #include <optional>
 
 namespace synbench::emulator::firmware {
+
+// A position error wrapped to (-pi/2, pi/2]: a SynRM's reluctance repeats every half electrical
+// turn, so an estimate half a turn off is as good as the encoder's.
+inline double half_turn_error_rad(double err_rad) {
+  constexpr double kHalfTurn = 3.14159265358979323846;
+  const double e = std::remainder(err_rad, kHalfTurn);
+  return e <= -kHalfTurn / 2 ? e + kHalfTurn : e;
+}
 
 struct EstimatorInput {
   double ts_s = 1e-4;

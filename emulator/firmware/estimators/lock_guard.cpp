@@ -6,18 +6,11 @@
 namespace synbench::emulator::firmware {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Within the guard angle this long before the angle guard arms [assumed].
 constexpr double kArm_s = 0.05;
 // Not yet armed, off the encoder's speed by more than the guard speed this long: the estimator
 // never found the rotor [assumed].
 constexpr double kUnfound_s = 0.2;
-
-// Wrapped to (-pi/2, pi/2]: a SynRM's reluctance repeats every half electrical turn.
-double half_turn_error(double a) {
-  a = std::remainder(a, kPi);
-  return a <= -kPi / 2 ? a + kPi : a;
-}
 
 }  // namespace
 
@@ -35,7 +28,7 @@ void LockGuard::update(const EstimatorInput& in) {
   if (tripped_) return;  // the lost estimator is replaced at the re-arm; nothing to feed
   inner_->update(in);
   const EstimatorOutput o = inner_->output();
-  const double err = half_turn_error(o.theta_e_rad - enc_theta_);
+  const double err = half_turn_error_rad(o.theta_e_rad - enc_theta_);
   const double speed_err = std::fabs(o.omega_e_rad_s - enc_omega_);
   const bool beyond =
       std::fabs(err) > guard_rad_ || (guard_speed_rad_s_ > 0 && speed_err > guard_speed_rad_s_);
