@@ -33,8 +33,8 @@ struct RowBuilder {
     rows.push_back({std::move(key), f, 0, 0, false, {}, assumed, std::move(source), std::move(doc)});
   }
   void choice(std::string key, std::string* f, std::vector<std::string> choices, std::string source,
-              std::string doc) {
-    rows.push_back({std::move(key), f, 0, 0, false, std::move(choices), false, std::move(source),
+              std::string doc, bool assumed = false) {
+    rows.push_back({std::move(key), f, 0, 0, false, std::move(choices), assumed, std::move(source),
                     std::move(doc)});
   }
 };
@@ -185,6 +185,12 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
            "position source below the minimum speed");
   b.pos("estimators.eemf.lut_ld_scale", &e.lut_ld_scale, "Sec. 4 (4.1)", "EEMF-LUT table deformation kd (1 = exact tables)");
   b.pos("estimators.eemf.lut_lq_scale", &e.lut_lq_scale, "Sec. 4 (4.2)", "EEMF-LUT table deformation kq (1 = exact tables)");
+  b.choice("estimators.eemf.lut_rotation_speed", &e.lut_rotation_speed, {"observer", "active-flux"}, "Sec. 6.2.3",
+           "EEMF-LUT: rotor speed in the w Lq terms and the derivative's frame, the tracking observer's (the thesis; EEMF-CONST and EEMF-RLS always) or the active flux's (ours, docs/estimators.md)");
+  b.num("estimators.eemf.flux_blend_rad_s", &e.flux_blend_rad_s, 0, 1000, "assumed",
+        "active-flux speed: below this the voltage model's flux is pulled to the model's at the estimated angle", A);
+  b.num("estimators.eemf.flux_speed_filter_s", &e.flux_speed_filter_s, 0, 1, "assumed",
+        "active-flux speed: low-pass time constant on the active flux angle's rate", A);
   b.num("estimators.eemf.rls_forgetting", &e.rls_forgetting, 0.5, 1.0, "Sec. 6.2.3", "RLS forgetting factor");
   b.pos("estimators.eemf.rls_p0", &e.rls_p0, "Sec. 6.2.3", "RLS initial covariance diagonal");
   b.num("estimators.eemf.rls_sample_s", &e.rls_sample_s, 1e-5, 0.1, "assumed", "RLS sample period", A);

@@ -7,7 +7,12 @@ namespace synbench::emulator::firmware {
 
 Eemf::Eemf(const EemfParams& p)
     : p_(p), fd_(p.flux_d), fq_(p.flux_q),
-      tuner_(p.stiffness, p.observer_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s) {
+      tuner_(p.stiffness, p.observer_bandwidth_Hz, p.stiffness_current_filter_s, p.ts_s),
+      flux_speed_([&p] {
+        ActiveFluxSpeedParams f = p.flux_speed;
+        f.ts_s = p.ts_s;
+        return f;
+      }()) {
   obs_.configure(p_.observer_bandwidth_Hz);
   eg_f_.configure(p_.emf_filter_s, p_.ts_s);
   ig_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
@@ -39,6 +44,31 @@ void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) 
       lq_static = estimate_ ? estimate_->lq_H : p_.lq_H;
       return;
   }
+}
+
+Eemf::Flux Eemf::model_flux(double ig, double id) const {
+  double ld_dyn = 0, lq = 0;
+  switch (p_.model) {
+    case EemfModel::lut: {
+      const double kd = p_.lut_ld_scale, kq = p_.lut_lq_scale;
+      lq = kq * fq_.static_inductance_H(id / kq);
+      return {kd * fd_.static_inductance_H(ig / kd) * ig, lq * id, lq};
+    }
+    case EemfModel::constant:
+    case EemfModel::rls:
+      inductances(ig, id, ld_dyn, lq);  // linear: no current dependence
+      return {ld_dyn * ig, lq * id, lq};
+  }
+  return {};
+}
+
+void Eemf::update_flux_speed(const EstimatorInput& in, double th, double ig, double id,
+                             double rs) {
+  const Flux f = model_flux(ig, id);
+  const double c = std::cos(th), s = std::sin(th);
+  flux_speed_.update(in.ualpha_V, in.ubeta_V, in.ialpha_A, in.ibeta_A, rs,
+                     c * f.psi_g_Wb - s * f.psi_d_Wb, s * f.psi_g_Wb + c * f.psi_d_Wb,
+                     f.lq_static_H);
 }
 
 void Eemf::update(const EstimatorInput& in) {
@@ -95,7 +125,12 @@ void Eemf::update(const EstimatorInput& in) {
   // Table look-ups on smoothed currents: noise must not modulate the inductances.
   inductances(ig_f_.update(ig), id_f_.update(id), ld_dyn, lq);
   const double rs = (p_.model == EemfModel::rls && estimate_) ? estimate_->rs_ohm : p_.rs_ohm;
-  // The current's derivative in a frame turning at the estimated ROTOR speed w, not at the
+  double w_rot = w;
+  if (p_.rotation_speed == EemfRotationSpeed::active_flux) {
+    update_flux_speed(in, th, ig, id, rs);
+    w_rot = flux_speed_.omega_e_rad_s();
+  }
+  // The current's derivative in a frame turning at the estimated ROTOR speed w_rot, not at the
   // estimated frame's own speed w + kp err: the observer's proportional path turns the frame
   // against the rotor, and with the current loops holding i_g,d in that frame the rotor sees its
   // current vector turn, a real L'd p i that the frame-relative derivative misses. Read as EEMF
@@ -104,7 +139,7 @@ void Eemf::update(const EstimatorInput& in) {
   // current angles in the sweeps and could not take a higher bandwidth (docs/estimators.md).
   double dig = 0.0, did = 0.0;
   if (have_prev_) {
-    const double thp = th - w * ts;
+    const double thp = th - w_rot * ts;
     const double cp = std::cos(thp), sp = std::sin(thp);
     dig = (ig - (cp * ia_prev_ + sp * ib_prev_)) / ts;
     did = (id - (-sp * ia_prev_ + cp * ib_prev_)) / ts;
@@ -112,8 +147,8 @@ void Eemf::update(const EstimatorInput& in) {
   ia_prev_ = in.ialpha_A;
   ib_prev_ = in.ibeta_A;
   have_prev_ = true;
-  const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w * lq * id);
-  const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w * lq * ig);
+  const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w_rot * lq * id);
+  const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w_rot * lq * ig);
   // The angle error from the EEMF's line, not its arrow [assumed]: atan(-e_g / e_d), modulo
   // 180 deg. The EEMF (Ld - Lq)(w i_d - p i_q) lies on the q axis but flips its sign when a q-current
   // transient outruns w i_d (high current angle, low speed): atan2 then reads an error near 180 deg

@@ -2,7 +2,9 @@
 // e_g = u_g - (Rs + L'd p) i_g + w Lq i_d, e_d = u_d - (Rs + L'd p) i_d - w Lq i_g; the angle
 // error atan2(-e_g, e_d) drives a PI tracking observer (5 Hz, raised where the shaft makes an
 // angle error grow) whose integral is the angle; p i is taken in a frame turning at the estimated
-// rotor speed, and the reported speed (the PI's output) is low-passed.
+// rotor speed, and the reported speed (the PI's output) is low-passed. The rotor speed in those
+// rotation terms is the observer's integrator (the thesis) or the active flux's
+// (active_flux_speed.hpp) [ours].
 // Three sources of Rs, L'd, Lq as in the thesis: constant (Ld = 0.65 H, Lq = 0.2 H), the
 // flux-map tables (optionally deformed, thesis 4.1 and 4.2), or RLS identification excited by
 // PRBS voltage injection on both axes.
@@ -10,6 +12,7 @@
 
 #include <optional>
 
+#include "emulator/firmware/estimators/active_flux_speed.hpp"
 #include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/estimators/rls.hpp"
 #include "emulator/firmware/estimators/shaft_stiffness.hpp"
@@ -21,6 +24,9 @@
 namespace synbench::emulator::firmware {
 
 enum class EemfModel { constant, lut, rls };
+
+// Where the rotor speed of the EEMF's rotation terms (w Lq, the derivative's frame) comes from.
+enum class EemfRotationSpeed { observer, active_flux };
 
 struct EemfParams {
   double ts_s = 1e-4;
@@ -39,6 +45,8 @@ struct EemfParams {
   double speed_filter_s = 0.0;          // [assumed] low-pass on the reported speed (0: none)
   double emf_filter_s = 5e-3;           // [assumed] low-pass on e before the angle error
   double emf_floor_V = 5.0;             // [assumed] |e| below which the angle error is faded out
+  EemfRotationSpeed rotation_speed = EemfRotationSpeed::observer;
+  ActiveFluxSpeedParams flux_speed;     // for EemfRotationSpeed::active_flux
   double rls_forgetting = 0.99;         // Sec. 6.2.3
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;           // [assumed] RLS sample period (a multiple of ts_s)
@@ -56,10 +64,18 @@ class Eemf final : public Estimator {
   void align(double theta_e_rad, double omega_e_rad_s) override {
     obs_.reset(theta_e_rad, omega_e_rad_s);
     speed_f_.reset(omega_e_rad_s);
+    flux_speed_.align(omega_e_rad_s);
   }
 
  private:
   void inductances(double ig, double id, double& ld_dyn, double& lq_static) const;
+  // The model's flux linkages and static q inductance at the present currents (not smoothed:
+  // the active flux psi - Lq i must lose its q part at every instant, transients included).
+  struct Flux {
+    double psi_g_Wb, psi_d_Wb, lq_static_H;
+  };
+  Flux model_flux(double ig, double id) const;
+  void update_flux_speed(const EstimatorInput& in, double th, double ig, double id, double rs);
 
   EemfParams p_;
   FluxAxis fd_, fq_;
@@ -67,6 +83,7 @@ class Eemf final : public Estimator {
   LowPass eg_f_, ed_f_, ig_f_, id_f_;
   StiffnessTuner tuner_;
   LowPass speed_f_;
+  ActiveFluxSpeed flux_speed_;
   double ia_prev_ = 0, ib_prev_ = 0;  // the last current sample, stationary frame
   bool have_prev_ = false;
   // RLS and its excitation.

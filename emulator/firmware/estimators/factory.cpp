@@ -54,6 +54,12 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   p.stiffness = stiffness(config);
   p.stiffness.margin = e.stiffness_margin;
   p.speed_filter_s = e.speed_filter_s;
+  // The active flux needs the machine's q flux: only the tables have it (active_flux_speed.hpp).
+  p.rotation_speed = model == EemfModel::lut && e.lut_rotation_speed == "active-flux"
+                         ? EemfRotationSpeed::active_flux
+                         : EemfRotationSpeed::observer;
+  p.flux_speed.blend_rad_s = e.flux_blend_rad_s;
+  p.flux_speed.speed_filter_s = e.flux_speed_filter_s;
   p.rls_forgetting = e.rls_forgetting;
   p.rls_p0 = e.rls_p0;
   p.rls_sample_s = e.rls_sample_s;
