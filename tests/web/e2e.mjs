@@ -80,7 +80,15 @@ try {
   await page.fill('#b-span', '0.2');
   await page.fill('#b-settle', '0.2');
   await page.fill('#b-timeout', '3');
+  // Gate averaging: the plan's, and one configuration's own (an injecting estimator's, say).
+  await page.fill('#b-average', '0.05');
+  await page.fill('#b-configs .cfgrow [data-role="avg"]', '0.1');
   await page.uncheck('#b-thermal');
+  const sent = await until(async () => {
+    const j = JSON.parse((await text(page, '#b-json')) || '{}');
+    return j.gate?.average_s === 0.05 && j.dimensions?.configurations?.[0]?.gate_average_s === 0.1 ? j : null;
+  }, 5000);
+  check(sent, 'the plan carries the gate averaging, the plan\'s and the configuration\'s');
   check(await until(async () => (await attr(page, '#b-estimate', 'data-points')) === '12', 5000),
     `the estimate shows 12 points (${await text(page, '#b-estimate')})`);
   await shot(page, artifacts, '03-builder');

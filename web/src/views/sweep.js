@@ -144,12 +144,16 @@ export class SweepView {
     const n = $('#b-configs').children.length + 1;
     row.innerHTML = `<select aria-label="Configuration ${n}: estimator" data-role="est">${ESTIMATORS.map((e) => `<option ${e === c.estimator ? 'selected' : ''}>${e}</option>`).join('')}</select>
       <select aria-label="Configuration ${n}: PWM" data-role="pwm"><option value="capwm" ${c.pwm === 'capwm' ? 'selected' : ''}>CAPWM</option><option value="aspwm" ${c.pwm === 'aspwm' ? 'selected' : ''}>ASPWM</option></select>
+      <input type="number" step="any" min="0" data-role="avg" placeholder="plan's" title="gate averaging for this configuration (s); empty: the plan's" aria-label="Configuration ${n}: gate averaging (s)">
       <button type="button" class="small" aria-label="Remove configuration ${n}">Remove</button>`;
     row.dataset.min = c.min_speed_rpm ?? '';
     row.dataset.max = c.max_speed_rpm ?? '';
-    row.dataset.avg = c.gate_average_s ?? '';
+    const avg = row.querySelector('[data-role="avg"]');
+    avg.value = c.gate_average_s ?? '';
     row.querySelector('button').addEventListener('click', () => { row.remove(); this.changed(); });
-    row.querySelector('[data-role="est"]').addEventListener('change', () => { row.dataset.min = ''; row.dataset.max = ''; row.dataset.avg = ''; });
+    // A preset's speed bounds and averaging belong to its estimator (EEMF from 500 rpm, the
+    // injecting estimators averaged): a new estimator starts without them.
+    row.querySelector('[data-role="est"]').addEventListener('change', () => { row.dataset.min = ''; row.dataset.max = ''; avg.value = ''; });
     $('#b-configs').append(row);
   }
 
@@ -197,6 +201,7 @@ export class SweepView {
     $('#b-span').value = plan.gate?.span_s ?? 0.5;
     $('#b-settle').value = plan.gate?.min_settle_s ?? 0.5;
     $('#b-timeout').value = plan.gate?.timeout_s ?? 30;
+    $('#b-average').value = plan.gate?.average_s ?? 0;
     $('#b-thermal').checked = plan.thermal?.enabled ?? true;
     this.syncVisibility();
     this.changed();
@@ -224,7 +229,8 @@ export class SweepView {
       const c = { estimator: row.querySelector('[data-role="est"]').value, pwm: row.querySelector('[data-role="pwm"]').value };
       if (row.dataset.min !== '') c.min_speed_rpm = Number(row.dataset.min);
       if (row.dataset.max !== '' && row.dataset.max !== 'null') c.max_speed_rpm = Number(row.dataset.max);
-      if (row.dataset.avg !== '' && row.dataset.avg !== 'null') c.gate_average_s = Number(row.dataset.avg);
+      const avg = row.querySelector('[data-role="avg"]').value.trim();
+      if (avg !== '') c.gate_average_s = Number(avg);
       return c;
     });
     plan.dimensions = dims;
@@ -235,7 +241,8 @@ export class SweepView {
       delete plan.adaptive;
     }
     plan.window_s = Number($('#b-window').value);
-    plan.gate = { ...(plan.gate || {}), span_s: Number($('#b-span').value), min_settle_s: Number($('#b-settle').value), timeout_s: Number($('#b-timeout').value) };
+    plan.gate = { ...(plan.gate || {}), span_s: Number($('#b-span').value), min_settle_s: Number($('#b-settle').value), timeout_s: Number($('#b-timeout').value),
+      average_s: Number($('#b-average').value) };
     plan.thermal = { ...(plan.thermal || {}), enabled: $('#b-thermal').checked };
     return plan;
   }
