@@ -16,6 +16,11 @@
 // frequency (100 rad/s and more where the EEMF runs) that is a small, slowly varying phase
 // offset, which the speed does not see. The speed is the angle's rate low-passed over
 // `speed_filter_s`.
+//
+// It needs the model's q flux to be the machine's: with a wrong Lq the active flux keeps a q part
+// and its angle moves with every q-current change (EEMF-CONST on it lost the rotor at 68 points
+// of the thesis grid instead of none). The drive uses it with the flux-map tables only
+// (`estimators.eemf.lut_rotation_speed`).
 #pragma once
 
 #include <cmath>

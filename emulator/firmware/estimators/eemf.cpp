@@ -34,9 +34,9 @@ void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) 
     case EemfModel::lut: {
       // Deformed tables L^ = k f(i / k) (thesis 4.1, 4.2); without cross-saturation each axis
       // depends on its own current only.
-      const double kd = p_.lut_ld_scale, kq = p_.lut_lq_scale;
+      const double kd = p_.lut_ld_scale;
       ld_dyn = kd * fd_.dynamic_inductance_H(ig / kd);
-      lq_static = kq * fq_.static_inductance_H(id / kq);
+      lq_static = lut_static_H(fq_, p_.lut_lq_scale, id);
       return;
     }
     case EemfModel::rls:
@@ -49,11 +49,9 @@ void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) 
 Eemf::Flux Eemf::model_flux(double ig, double id) const {
   double ld_dyn = 0, lq = 0;
   switch (p_.model) {
-    case EemfModel::lut: {
-      const double kd = p_.lut_ld_scale, kq = p_.lut_lq_scale;
-      lq = kq * fq_.static_inductance_H(id / kq);
-      return {kd * fd_.static_inductance_H(ig / kd) * ig, lq * id, lq};
-    }
+    case EemfModel::lut:
+      lq = lut_static_H(fq_, p_.lut_lq_scale, id);
+      return {lut_static_H(fd_, p_.lut_ld_scale, ig) * ig, lq * id, lq};
     case EemfModel::constant:
     case EemfModel::rls:
       inductances(ig, id, ld_dyn, lq);  // linear: no current dependence

@@ -69,6 +69,10 @@ class Eemf final : public Estimator {
 
  private:
   void inductances(double ig, double id, double& ld_dyn, double& lq_static) const;
+  // A deformed table's static inductance L^ = k f(i / k) (thesis 4.1, 4.2).
+  static double lut_static_H(const FluxAxis& axis, double k, double i) {
+    return k * axis.static_inductance_H(i / k);
+  }
   // The model's flux linkages and static q inductance at the present currents (not smoothed:
   // the active flux psi - Lq i must lose its q part at every instant, transients included).
   struct Flux {
