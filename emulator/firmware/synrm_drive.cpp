@@ -16,7 +16,10 @@ constexpr double kStoppedRpm = 20.0;
 // Zero current after a lock guard trip [assumed]: several current-loop time constants (4 ms).
 constexpr double kGuardRecovery_s = 0.02;
 
-double wrap_pi(double x) {
+// [-pi, pi). Not estimator.hpp's wrap_pi: this one rounds a small angle through x + pi - pi, and
+// the sweeps' lost-lock counts, chaotic in such last bits, are measured with it (switched, the
+// thesis sweep's EEMF-LUT read 137 guarded points instead of 134, 2026-12-02).
+double wrap_pi_drive(double x) {
   x = std::fmod(x + kPi, 2.0 * kPi);
   if (x < 0) x += 2.0 * kPi;
   return x - kPi;
@@ -196,7 +199,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
 
   check_protection(s, ia, ib, speed_rpm);
 
-  const double theta_enc = wrap_pi(pole_pairs_ * theta_m);
+  const double theta_enc = wrap_pi_drive(pole_pairs_ * theta_m);
   const double i_alpha = ia, i_beta = (ia + 2.0 * ib) / kSqrt3;  // Clarke with ic = -ia - ib
   double theta_e = theta_enc, we = pole_pairs_ * obs_omega_;
   if (estimator_) {
@@ -214,7 +217,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
     }
     estimator_->update(in);
     const EstimatorOutput o = estimator_->output();
-    theta_e = wrap_pi(o.theta_e_rad);
+    theta_e = wrap_pi_drive(o.theta_e_rad);
     we = o.omega_e_rad_s;
     if (estimator_->lock_lost() && !guard_held_) {
       // The lock guard moved the frame onto the encoder's in one period, with the current off

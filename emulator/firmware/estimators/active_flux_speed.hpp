@@ -25,6 +25,7 @@
 
 #include <cmath>
 
+#include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/pi.hpp"
 
 namespace synbench::emulator::firmware {
@@ -57,21 +58,13 @@ class ActiveFluxSpeed {
       psi_b_ += p_.ts_s * (ub_V - rs_ohm * ib_A + p_.blend_rad_s * (psi_model_b_Wb - psi_b_));
     }
     const double angle = std::atan2(psi_b_ - lq_H * ib_A, psi_a_ - lq_H * ia_A);
-    if (started_) {
-      // One sample turns the flux by w Ts, far less than half a turn.
-      constexpr double kTurn = 2.0 * 3.14159265358979323846;
-      double step = angle - angle_;
-      if (step > 0.5 * kTurn) step -= kTurn;
-      if (step < -0.5 * kTurn) step += kTurn;
-      speed_f_.update(step / p_.ts_s);
-    }
+    // One sample turns the flux by w Ts, far less than half a turn.
+    if (started_) speed_f_.update(wrap_pi(angle - angle_) / p_.ts_s);
     angle_ = angle;
     started_ = true;
   }
 
   double omega_e_rad_s() const { return speed_f_.value(); }
-  // The active flux's angle (electrical, stationary frame), for tests.
-  double angle_rad() const { return angle_; }
 
  private:
   ActiveFluxSpeedParams p_;

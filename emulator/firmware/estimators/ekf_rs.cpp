@@ -14,15 +14,6 @@ namespace synbench::emulator::firmware {
 
 namespace {
 
-double wrap_pi(double a) {
-  constexpr double pi = std::numbers::pi;
-  if (a > pi && a <= 3.0 * pi) return a - 2.0 * pi;  // the usual case: one period per step
-  if (a <= -pi && a > -3.0 * pi) return a + 2.0 * pi;
-  if (a > -pi && a <= pi) return a;
-  a = std::remainder(a, 2.0 * pi);  // [-pi, pi]
-  return a <= -pi ? a + 2.0 * pi : a;
-}
-
 bool valid_phase(int phase) { return phase >= 0 && phase < 3; }
 
 // cos and sin of the MCIDC phase offsets, so the update needs no trigonometry beyond th_e's.

@@ -8,6 +8,16 @@
 
 namespace synbench::emulator::firmware {
 
+// An angle wrapped to (-pi, pi]. Cheap for the usual case, an angle at most one turn out.
+inline double wrap_pi(double a) {
+  constexpr double pi = 3.14159265358979323846;
+  if (a > -pi && a <= pi) return a;
+  if (a > pi && a <= 3.0 * pi) return a - 2.0 * pi;
+  if (a <= -pi && a > -3.0 * pi) return a + 2.0 * pi;
+  a = std::remainder(a, 2.0 * pi);  // [-pi, pi]
+  return a <= -pi ? a + 2.0 * pi : a;
+}
+
 // A position error wrapped to (-pi/2, pi/2]: a SynRM's reluctance repeats every half electrical
 // turn, so an estimate half a turn off is as good as the encoder's.
 inline double half_turn_error_rad(double err_rad) {
