@@ -146,6 +146,7 @@ struct EemfConfig {
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;
   double rls_estimate_filter_s = 0.2;  // low-pass on the estimates the observer uses
+  double rls_warmup_s = 0.3;           // identification time before the observer uses it
   std::string lut_rotation_speed = "observer";  // the thesis; or "active-flux" [ours]
   double flux_blend_rad_s = 5.0;
   double flux_speed_filter_s = 0.015;

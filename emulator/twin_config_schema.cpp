@@ -196,6 +196,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.num("estimators.eemf.rls_sample_s", &e.rls_sample_s, 1e-5, 0.1, "assumed", "RLS sample period", A);
   b.num("estimators.eemf.rls_estimate_filter_s", &e.rls_estimate_filter_s, 0, 100, "assumed",
         "low-pass time constant on the RLS estimates the observer uses", A);
+  b.num("estimators.eemf.rls_warmup_s", &e.rls_warmup_s, 0, 100, "assumed",
+        "identification time before the observer takes the RLS estimates (the constants until then)", A);
   b.num("estimators.eemf.prbs_voltage_V", &e.prbs_voltage_V, 0, 100, "Sec. 6.2.3", "PRBS amplitude on both axes");
   b.pos("estimators.eemf.prbs_bit_s", &e.prbs_bit_s, "Sec. 6.2.3", "PRBS bit period");
   b.num("estimators.ekf.rs_speed_threshold_rpm", &c.estimators.ekf.rs_speed_threshold_rpm, 0, 10000, "assumed",

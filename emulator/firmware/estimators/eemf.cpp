@@ -22,6 +22,7 @@ Eemf::Eemf(const EemfParams& p)
   if (p_.model == EemfModel::rls) {
     rls_every_ = std::max(1, static_cast<int>(std::lround(p_.rls_sample_s / p_.ts_s)));
     rls_.emplace(p_.rls_forgetting, p_.rls_p0, rls_every_ * p_.ts_s);
+    rls_warmup_intervals_ = std::lround(p_.rls_warmup_s / (rls_every_ * p_.ts_s));
   }
 }
 
@@ -93,21 +94,24 @@ void Eemf::update(const EstimatorInput& in) {
     } else {
       const double n = rls_every_;
       const double inner = std::max(1, rls_every_ - 1);
-      if (rls_have_prev_ && rls_every_ > 1)
+      if (rls_have_prev_ && rls_every_ > 1) {
         rls_->update(ig - rls_ig0_, id - rls_id0_, rls_ig_sum_ / inner, rls_id_sum_ / inner,
                      rls_ug_sum_ / n, rls_ud_sum_ / n);
-      // Plausible estimates only, smoothed: the observer must not follow every wobble of a
-      // 100 ms identification memory.
-      if (auto e = rls_->estimate(); e && e->rs_ohm > 0 && e->rs_ohm < 5 * p_.rs_ohm &&
-                                     e->ld_H > 0.01 && e->lq_H > 0.01 && e->ld_H < 2 && e->lq_H < 2) {
-        if (!estimate_) {
-          estimate_ = e;
-        } else {
-          const double a = p_.rls_sample_s / (p_.rls_estimate_filter_s + p_.rls_sample_s);
-          estimate_->rs_ohm += a * (e->rs_ohm - estimate_->rs_ohm);
-          estimate_->ld_H += a * (e->ld_H - estimate_->ld_H);
-          estimate_->lq_H += a * (e->lq_H - estimate_->lq_H);
-        }
+        ++rls_intervals_;
+      }
+      // Plausible estimates only, once warmed up, smoothed: the observer must not follow every
+      // wobble of a 100 ms identification memory. A fresh estimator handed a running rotor (the
+      // lock guard's re-arm at 700 rpm) took its first fit at once and lost the rotor in 0.1 s.
+      const auto e = rls_->estimate();
+      const bool plausible = e && e->rs_ohm > 0 && e->rs_ohm < 5 * p_.rs_ohm && e->ld_H > 0.01 &&
+                             e->lq_H > 0.01 && e->ld_H < 2 && e->lq_H < 2;
+      if (plausible && rls_intervals_ >= rls_warmup_intervals_) {
+        // From the constants the observer ran on, not a step onto the first fit.
+        if (!estimate_) estimate_ = StatorEstimate{p_.rs_ohm, p_.ld_H, p_.lq_H};
+        const double a = p_.rls_sample_s / (p_.rls_estimate_filter_s + p_.rls_sample_s);
+        estimate_->rs_ohm += a * (e->rs_ohm - estimate_->rs_ohm);
+        estimate_->ld_H += a * (e->ld_H - estimate_->ld_H);
+        estimate_->lq_H += a * (e->lq_H - estimate_->lq_H);
       }
       rls_ig0_ = ig;
       rls_id0_ = id;

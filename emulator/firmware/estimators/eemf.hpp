@@ -51,6 +51,9 @@ struct EemfParams {
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;           // [assumed] RLS sample period (a multiple of ts_s)
   double rls_estimate_filter_s = 0.2;   // [assumed] low-pass on the estimates the observer uses
+  // [assumed] The observer runs on the constants until the RLS has identified this long: from
+  // P0 = 1e5 I its first estimates are whatever the first few intervals fit.
+  double rls_warmup_s = 0.3;
   double prbs_voltage_V = 20.0;         // Sec. 6.2.3
   double prbs_bit_s = 0.01;
 };
@@ -96,6 +99,7 @@ class Eemf final : public Estimator {
   Prbs5 prbs_g_{0b10011}, prbs_d_{0b01101};
   double inj_g_ = 0, inj_d_ = 0;
   int rls_every_ = 10, rls_count_ = 0;
+  long rls_intervals_ = 0, rls_warmup_intervals_ = 0;
   bool rls_have_prev_ = false;
   double rls_ig0_ = 0, rls_id0_ = 0;
   double rls_ug_sum_ = 0, rls_ud_sum_ = 0, rls_ig_sum_ = 0, rls_id_sum_ = 0;
