@@ -37,17 +37,18 @@ void PointProcedure::enter(PointPhase p, double now_s) {
 }
 
 void PointProcedure::begin_stop(double now_s, bool ramped) {
-  // Ordered stop, step one: the load first, so the SynRM is never driven by the load. After a
-  // measured point at the bench's ramp, as between points (a sensorless drive at a high current
-  // angle must follow the acceleration); after a fault at once (the load drive's own ramp): a
-  // faulted stop must not wait on the bench's ticks.
-  if (ramped) {
-    command_load(0.0);
-  } else {
-    dev_.load->set_torque_Nm(0.0);
-    load_ramp_.start(0.0, 0.0);
-    load_pending_ = false;
-  }
+  // After a measured point the load comes off at the bench's ramp, as between points (a
+  // sensorless drive at a high current angle must follow the acceleration); after a fault at
+  // once (the load drive's own ramp): a faulted stop must not wait on the bench's ticks.
+  OrderedStopOptions o;
+  o.load_ramp_Nm_per_s = ramped ? opt_.load_ramp_Nm_per_s : 0.0;
+  o.stopped_speed_rpm = opt_.stop_speed_rpm;
+  o.speed_timeout_s = opt_.stop_timeout_s;
+  stop_ramped_ = o.load_ramp_Nm_per_s > 0;
+  const double from_Nm = load_ramp_.command();
+  load_ramp_.start(0.0, 0.0);  // the stop moves the load from here on
+  load_pending_ = false;
+  stop_.begin(dev_, o, now_s, from_Nm);
   enter(PointPhase::stop, now_s);
 }
 
@@ -80,7 +81,8 @@ void PointProcedure::tick(double now_s) {
     if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
     if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
     const auto fault = st.fault != drivers::Fault::none ? st.fault : lt.fault;
-    if (fault != drivers::Fault::none && (phase_ != PointPhase::stop || load_pending_)) {
+    const bool ramping_off = phase_ == PointPhase::stop && stop_ramped_ && stop_.step() == StopStep::load;
+    if (fault != drivers::Fault::none && (phase_ != PointPhase::stop || ramping_off)) {
       // A fault during the ramped stop of a measured point takes the load off at once too.
       if (phase_ != PointPhase::stop) {
         record_.fault = std::string(drivers::fault_name(fault));
@@ -227,19 +229,9 @@ void PointProcedure::tick(double now_s) {
       }
       return;
     }
-    case PointPhase::stop: {
-      // Step two once the load torque is gone: speed to zero; step three: disable.
-      const bool timed_out = now_s - t_phase_ > opt_.stop_timeout_s;
-      const bool load_gone = !load_pending_ && std::fabs(lt.torque_Nm) < 0.05;
-      if (load_gone || timed_out) dev_.synrm->set_speed_rpm(0.0);
-      if ((std::fabs(st.speed_rpm) < opt_.stop_speed_rpm && load_gone) || timed_out ||
-          st.state == drivers::DriveState::faulted) {
-        dev_.synrm->enable(false);
-        dev_.load->enable(false);
-        phase_ = error_.empty() ? PointPhase::done : PointPhase::failed;
-      }
+    case PointPhase::stop:
+      if (stop_.tick(now_s, st, lt)) phase_ = error_.empty() ? PointPhase::done : PointPhase::failed;
       return;
-    }
     case PointPhase::done:
     case PointPhase::failed:
       return;

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "bench/load_ramp.hpp"
+#include "bench/ordered_stop.hpp"
 #include "bench/point_record.hpp"
 #include "bench/steady_state.hpp"
 #include "drivers/clock.hpp"
@@ -32,7 +33,7 @@ struct PointOptions {
   double spin_up_timeout_s = 30.0;
   double speed_reached_band_rpm = 5.0;
   double stop_speed_rpm = 20.0;         // below this the drives are disabled
-  double stop_timeout_s = 30.0;
+  double stop_timeout_s = 30.0;        // the ordered stop's speed step, then disabled regardless
   double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
   bool ordered_stop_after = true;
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
@@ -110,6 +111,8 @@ class PointProcedure {
   LoadRamp load_ramp_;
   double t_last_tick_ = -1;
   bool load_pending_ = false;
+  OrderedStop stop_;
+  bool stop_ramped_ = false;  // the stop takes the load off at the ramp (a measured point)
   bool sensorless_start_ = false;  // a sensorless estimator, started from rest
   bool early_load_ = false;        // its load commanded before the speed was reached
   bool angle_pending_ = false;     // spun up at the sensorless start angle; its own comes when loaded

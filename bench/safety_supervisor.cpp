@@ -30,10 +30,13 @@ void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string det
   trip_ = SafetyTrip{fault, std::move(detail), now_s};
   if (sink_)
     sink_("fault", std::string(drivers::fault_name(fault)) + ": " + trip_->detail);
-  // Step one of the ordered stop: the load first, so the SynRM is never dragged by it.
-  dev_.load->set_torque_Nm(0.0);
+  // At once (the load drive's own ramp): a trip does not wait on a ramp.
+  OrderedStopOptions opt;
+  opt.load_timeout_s = lim_.stop_load_timeout_s;
+  opt.stopped_speed_rpm = lim_.stopped_speed_rpm;
+  opt.speed_timeout_s = lim_.stop_speed_timeout_s;
+  stop_.begin(dev_, opt, now_s, load_ ? load_->torque_Nm : 0.0);
   phase_ = SafetyPhase::stopping_load;
-  phase_since_s_ = now_s;
 }
 
 void SafetySupervisor::disable_all() {
@@ -42,26 +45,24 @@ void SafetySupervisor::disable_all() {
 }
 
 void SafetySupervisor::estop(double now_s, const std::string& why) {
+  stop_.cancel();
   disable_all();
   if (!trip_) {
     trip_ = SafetyTrip{drivers::Fault::estop, why, now_s};
     if (sink_) sink_("fault", "estop: " + why);
   }
   phase_ = SafetyPhase::estopped;
-  phase_since_s_ = now_s;
   stop_duration_s_ = 0.0;
 }
 
-std::error_code SafetySupervisor::reset(double now_s) {
-  if (phase_ == SafetyPhase::stopping_load || phase_ == SafetyPhase::stopping_speed)
-    return make_error_code(errc::busy);
+std::error_code SafetySupervisor::reset(double /*now_s*/) {
+  if (stop_.active()) return make_error_code(errc::busy);
   if (auto ec = dev_.synrm->reset_fault()) return ec;
   if (auto ec = dev_.load->reset_fault()) return ec;
   if (trip_ && sink_) sink_("state", "reset after " + std::string(drivers::fault_name(trip_->fault)));
   trip_.reset();
   stop_duration_s_.reset();
   phase_ = SafetyPhase::normal;
-  phase_since_s_ = now_s;
   return {};
 }
 
@@ -108,38 +109,14 @@ void SafetySupervisor::tick(double now_s) {
 }
 
 void SafetySupervisor::advance_stop(double now_s) {
-  const double in_phase = now_s - phase_since_s_;
-  switch (phase_) {
-    case SafetyPhase::stopping_load: {
-      dev_.load->set_torque_Nm(0.0);
-      const bool load_gone = load_ && std::fabs(load_->torque_Nm) < 0.05;
-      if (load_gone || in_phase > lim_.stop_load_timeout_s) {
-        // A load that did not let go is switched off before the speed comes down.
-        if (!load_gone) dev_.load->enable(false);
-        dev_.synrm->set_speed_rpm(0.0);  // step two
-        phase_ = SafetyPhase::stopping_speed;
-        phase_since_s_ = now_s;
-      }
-      return;
-    }
-    case SafetyPhase::stopping_speed: {
-      dev_.synrm->set_speed_rpm(0.0);
-      const bool still = synrm_ && std::fabs(synrm_->speed_rpm) < lim_.stopped_speed_rpm;
-      const bool already_off = synrm_ && !running(synrm_->state);
-      if (still || already_off || in_phase > lim_.stop_speed_timeout_s) {
-        disable_all();  // step three
-        phase_ = SafetyPhase::stopped;
-        phase_since_s_ = now_s;
-        stop_duration_s_ = now_s - trip_->at_s;
-        if (sink_) sink_("state", "ordered stop complete after " + std::to_string(*stop_duration_s_) + " s");
-      }
-      return;
-    }
-    case SafetyPhase::normal:
-    case SafetyPhase::stopped:
-    case SafetyPhase::estopped:
-      return;
+  if (!stop_.active()) return;
+  if (!stop_.tick(now_s, synrm_, load_)) {
+    phase_ = stop_.step() == StopStep::load ? SafetyPhase::stopping_load : SafetyPhase::stopping_speed;
+    return;
   }
+  phase_ = SafetyPhase::stopped;
+  stop_duration_s_ = now_s - trip_->at_s;
+  if (sink_) sink_("state", "ordered stop complete after " + std::to_string(*stop_duration_s_) + " s");
 }
 
 }  // namespace synbench::bench

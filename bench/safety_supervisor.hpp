@@ -9,6 +9,7 @@
 #include <string>
 #include <system_error>
 
+#include "bench/ordered_stop.hpp"
 #include "drivers/devices.hpp"
 
 namespace synbench::bench {
@@ -72,7 +73,7 @@ class SafetySupervisor {
   double last_good_read_s_ = 0;
   bool seen_good_read_ = false;
   SafetyPhase phase_ = SafetyPhase::normal;
-  double phase_since_s_ = 0;
+  OrderedStop stop_;
   std::optional<SafetyTrip> trip_;
   std::optional<double> stop_duration_s_;
 };

@@ -151,36 +151,23 @@ void SweepEngine::finish_point(double /*now_s*/) {
 }
 
 void SweepEngine::begin_stop(SweepState final_state, double now_s, bool coast) {
-  stopping_ = true;
-  coast_ = coast;
   after_stop_ = final_state;
-  stop_since_s_ = now_s;
   if (final_state != SweepState::running) state_ = SweepState::stopping;
   // The load comes off at the bench's ramp, as between points: removed at the load drive's
   // 10 N m/s, it let the shaft run away from EEMF-LUT at 500 rpm, 76 deg into an over-speed
   // trip. A drive that lost the shaft (coast) has nothing to follow: off at once.
+  OrderedStopOptions opt;
+  opt.load_ramp_Nm_per_s = coast ? 0.0 : options_.load_ramp_Nm_per_s;
+  opt.load_timeout_s = kStopLoadTimeout_s;
+  opt.stopped_speed_rpm = kStoppedRpm;
+  opt.speed_timeout_s = kStopSpeedTimeout_s;
+  opt.coast = coast;
   const auto& lt = sup_.load();
-  const double from_Nm = lt ? lt->torque_Nm : 0.0;
-  const double rate = coast ? 0.0 : options_.load_ramp_Nm_per_s;
-  stop_ramp_ = LoadRamp(rate);
-  stop_ramp_.start(from_Nm, 0.0);
-  stop_load_timeout_s_ = kStopLoadTimeout_s + (rate > 0 ? std::fabs(from_Nm) / rate : 0.0);
-  stop_tick_s_ = now_s;
-  dev_.load->set_torque_Nm(stop_ramp_.step(0.0));
+  stop_.begin(dev_, opt, now_s, lt ? lt->torque_Nm : 0.0);
 }
 
 void SweepEngine::tick_stop(double now_s) {
-  const auto& st = sup_.synrm();
-  const auto& lt = sup_.load();
-  if (!stop_ramp_.done()) dev_.load->set_torque_Nm(stop_ramp_.step(now_s - stop_tick_s_));
-  stop_tick_s_ = now_s;
-  const bool load_gone = stop_ramp_.done() && lt && std::fabs(lt->torque_Nm) < 0.05;
-  if (load_gone || now_s - stop_since_s_ > stop_load_timeout_s_) dev_.synrm->set_speed_rpm(0.0);
-  const bool still = st && std::fabs(st->speed_rpm) < kStoppedRpm;
-  if ((still && load_gone) || (coast_ && load_gone) || now_s - stop_since_s_ > kStopSpeedTimeout_s) {
-    dev_.synrm->enable(false);
-    dev_.load->enable(false);
-    stopping_ = false;
+  if (stop_.tick(now_s, sup_.synrm(), sup_.load())) {
     running_config_.reset();
     state_ = after_stop_;
     sink_.event("state", after_stop_ == SweepState::running
@@ -198,7 +185,7 @@ void SweepEngine::tick(double now_s) {
     // The supervisor has already brought the bench to its ordered stop.
     proc_.reset();
     current_.reset();
-    stopping_ = false;
+    stop_.cancel();
     state_ = SweepState::faulted;
     error_ = "safety supervisor tripped: " +
              (sup_.trip() ? std::string(drivers::fault_name(sup_.trip()->fault)) + " (" + sup_.trip()->detail + ")"
@@ -207,7 +194,7 @@ void SweepEngine::tick(double now_s) {
     sink_.progress(progress());
     return;
   }
-  if (stopping_) return tick_stop(now_s);
+  if (stop_.active()) return tick_stop(now_s);
   if (proc_) {
     if (abort_requested_) {
       proc_.reset();

@@ -16,7 +16,7 @@
 #include <system_error>
 #include <vector>
 
-#include "bench/load_ramp.hpp"
+#include "bench/ordered_stop.hpp"
 #include "bench/point_procedure.hpp"
 #include "bench/point_record.hpp"
 #include "bench/safety_supervisor.hpp"
@@ -105,10 +105,8 @@ class SweepEngine {
   std::unique_ptr<PointProcedure> proc_;
   std::optional<Configuration> running_config_;
   // The ordered stop between configurations or at the end.
-  bool stopping_ = false, coast_ = false;
   SweepState after_stop_ = SweepState::completed;
-  double stop_since_s_ = 0, stop_tick_s_ = 0, stop_load_timeout_s_ = 0;
-  LoadRamp stop_ramp_{0.0};
+  OrderedStop stop_;
   double t0_ = -1, now_ = 0;
   std::size_t measured_this_run_ = 0;
   std::string error_;

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "bench/point_procedure.hpp"
+
 namespace synbench::http {
 
 namespace {
-constexpr double kStopSpeed_rpm = 20.0;   // below this the drives are disabled
-constexpr double kStopTimeout_s = 10.0;   // then disabled regardless, as the supervisor does
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -96,20 +96,11 @@ void BenchRuntime::tick_locked(double now_s) {
   if (supervisor_->tripped()) {
     // The supervisor runs its own ordered stop; ours is void.
     enabled_ = false;
-    stopping_ = false;
+    stop_.cancel();
     return;
   }
-  if (stopping_) {
-    const auto& s = supervisor_->synrm();
-    const bool slow = s && std::abs(s->speed_rpm) < kStopSpeed_rpm;
-    if (slow || now_s - stop_since_s_ > kStopTimeout_s) {
-      auto dev = backend_->devices();
-      dev.synrm->enable(false);
-      dev.load->enable(false);
-      stopping_ = false;
-      event_locked("stop", slow ? "ordered stop complete" : "ordered stop timed out; drives disabled");
-    }
-  }
+  if (stop_.tick(now_s, supervisor_->synrm(), supervisor_->load()))
+    event_locked("stop", stop_.timed_out() ? "ordered stop timed out; drives disabled" : "ordered stop complete");
 }
 
 void BenchRuntime::finish_sweep_locked() {
@@ -137,7 +128,7 @@ std::optional<Refusal> BenchRuntime::start_sweep(std::int64_t id, bench::SweepPl
   if (supervisor_->tripped())
     return Refusal{409, "tripped", "the safety supervisor has tripped; POST /api/bench/reset first"};
   if (engine_) return Refusal{409, "sweep_running", "sweep " + std::to_string(sweep_id_) + " is running"};
-  if (enabled_ || stopping_) return Refusal{409, "bench_in_use", "the bench is enabled by hand; disable it first"};
+  if (enabled_ || stop_.active()) return Refusal{409, "bench_in_use", "the bench is enabled by hand; disable it first"};
   auto opened = db::Store::open(db_path);
   if (!opened) return Refusal{500, "database", opened.error().message};
   sweep_store_ = std::make_unique<db::Store>(std::move(*opened));
@@ -182,8 +173,8 @@ std::optional<Refusal> BenchRuntime::enable(bool on) {
   if (on) {
     if (supervisor_->tripped())
       return Refusal{409, "tripped", "the safety supervisor has tripped; POST /api/bench/reset first"};
-    if (enabled_ && !stopping_) return std::nullopt;
-    stopping_ = false;
+    if (enabled_ && !stop_.active()) return std::nullopt;
+    stop_.cancel();
     std::error_code ec;
     if ((ec = dev.synrm->set_estimator(mode_.estimator)) || (ec = dev.synrm->set_pwm(mode_.pwm)))
       return Refusal{502, "device_error", "setting the drive mode: " + ec.message()};
@@ -196,12 +187,14 @@ std::optional<Refusal> BenchRuntime::enable(bool on) {
     event_locked("enable", "drives enabled");
     return std::nullopt;
   }
-  if (!enabled_ || stopping_) return std::nullopt;
+  if (!enabled_ || stop_.active()) return std::nullopt;
   enabled_ = false;
-  stopping_ = true;
-  stop_since_s_ = backend_->clock().now_s();
-  dev.load->set_torque_Nm(0.0);
-  dev.synrm->set_speed_rpm(0.0);
+  // At the bench's ramp, as a sweep's stop: a sensorless drive at a high current angle must
+  // follow the acceleration.
+  bench::OrderedStopOptions opt;
+  opt.load_ramp_Nm_per_s = bench::PointOptions{}.load_ramp_Nm_per_s;
+  const auto& lt = supervisor_->load();
+  stop_.begin(dev, opt, backend_->clock().now_s(), lt ? lt->torque_Nm : setpoints_.load_Nm);
   event_locked("stop", "ordered stop requested");
   return std::nullopt;
 }
@@ -213,14 +206,14 @@ std::optional<Refusal> BenchRuntime::set_setpoints(const Setpoints& sp) {
   if (engine_) return Refusal{409, "sweep_running", "sweep " + std::to_string(sweep_id_) + " drives the bench; abort it first"};
   setpoints_ = sp;
   event_locked("setpoints", "speed " + fmt(sp.speed_rpm) + " rpm, load " + fmt(sp.load_Nm) + " Nm, angle " + fmt(sp.angle_deg) + " deg");
-  if (enabled_ && !stopping_) return apply_locked();
+  if (enabled_ && !stop_.active()) return apply_locked();
   return std::nullopt;
 }
 
 std::optional<Refusal> BenchRuntime::set_mode(const DriveMode& mode) {
   std::lock_guard lock(mutex_);
   if (engine_) return Refusal{409, "sweep_running", "sweep " + std::to_string(sweep_id_) + " drives the bench; abort it first"};
-  if (enabled_ || stopping_) return Refusal{409, "bench_enabled", "the drives are enabled; disable them before switching the estimator or PWM"};
+  if (enabled_ || stop_.active()) return Refusal{409, "bench_enabled", "the drives are enabled; disable them before switching the estimator or PWM"};
   mode_ = mode;
   event_locked("mode", "estimator " + std::string(drivers::name(mode.estimator)) + ", pwm " + std::string(drivers::name(mode.pwm)));
   return std::nullopt;
@@ -230,7 +223,7 @@ void BenchRuntime::estop() {
   std::lock_guard lock(mutex_);
   supervisor_->estop(backend_->clock().now_s(), "E-stop (REST)");
   enabled_ = false;
-  stopping_ = false;
+  stop_.cancel();
 }
 
 std::optional<Refusal> BenchRuntime::reset() {
@@ -245,7 +238,7 @@ BenchStatus BenchRuntime::status() const {
   BenchStatus s;
   s.t_s = backend_->clock().now_s();
   s.enabled = enabled_;
-  s.stopping = stopping_;
+  s.stopping = stop_.active();
   s.setpoints = setpoints_;
   s.mode = mode_;
   s.synrm = supervisor_->synrm();
@@ -284,7 +277,7 @@ void BenchRuntime::shutdown(std::chrono::milliseconds timeout) {
         const auto ph = supervisor_->phase();
         const bool supervisor_done = ph == bench::SafetyPhase::normal || ph == bench::SafetyPhase::stopped ||
                                      ph == bench::SafetyPhase::estopped;
-        if (!engine_ && !stopping_ && supervisor_done) break;
+        if (!engine_ && !stop_.active() && supervisor_done) break;
       }
       std::this_thread::sleep_for(kTick);
     }

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <map>
 
+#include "bench/ordered_stop.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
 #include "db/store.hpp"
@@ -129,8 +130,7 @@ class BenchRuntime {
   std::condition_variable wake_;
   bool quit_ = false;
   bool enabled_ = false;
-  bool stopping_ = false;
-  double stop_since_s_ = 0;
+  bench::OrderedStop stop_;  // a user's disable or a shutdown
   Setpoints setpoints_;
   DriveMode mode_;
   std::uint64_t ticks_ = 0, overruns_ = 0;

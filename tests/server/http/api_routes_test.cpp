@@ -3,6 +3,9 @@
 // follows a speed setpoint.
 #include "server/http/api_routes.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -69,6 +72,42 @@ TEST_F(Api, TwinFollowsSpeedSetpointAndEstopLatches) {
   EXPECT_EQ(s["supervisor"]["phase"], "estopped");
   EXPECT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 409);
   EXPECT_EQ(post("/api/bench/reset", "").status, 200);
+}
+
+// A user's disable is the ordered stop: the load torque comes off at the bench's ramp while the
+// SynRM holds its speed, then the speed, then both drives (it used to zero both at once).
+TEST_F(Api, DisableTakesTheLoadOffBeforeTheSpeed) {
+  ASSERT_EQ(post("/api/bench/setpoints", R"({"speed_rpm": 500, "load_Nm": 1.5, "angle_deg": 50})").status, 200);
+  ASSERT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 200);
+  const auto status = [&] {
+    return nlohmann::json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body);
+  };
+  nlohmann::json st;
+  for (int i = 0; i < 80; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    st = status();
+    if (std::abs(st["synrm"]["speed_rpm"].get<double>() - 500) < 10 &&
+        std::abs(st["load"]["torque_Nm"].get<double>() - 1.5) < 0.05 && i > 20)
+      break;
+  }
+  ASSERT_NEAR(st["synrm"]["speed_rpm"].get<double>(), 500, 10);
+  ASSERT_EQ(post("/api/bench/enable", R"({"enabled": false})").status, 200);
+  double lowest_loaded_rpm = 1e9, load_gone_s = -1;
+  bool stopped = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 200 && !stopped; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    st = status();
+    const double torque = std::abs(st["load"]["torque_Nm"].get<double>());
+    if (torque > 0.1) lowest_loaded_rpm = std::min(lowest_loaded_rpm, st["synrm"]["speed_rpm"].get<double>());
+    if (torque < 0.05 && load_gone_s < 0)
+      load_gone_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stopped = !st["stopping"].get<bool>() && !st["enabled"].get<bool>();
+  }
+  EXPECT_TRUE(stopped);
+  EXPECT_GT(lowest_loaded_rpm, 450.0);
+  EXPECT_GT(load_gone_s, 0.5);  // 1.5 N m at 2 N m/s
+  EXPECT_LT(std::abs(st["synrm"]["speed_rpm"].get<double>()), 40.0);
 }
 
 TEST_F(Api, OneOperatorHoldsTheControlLockButAnyoneMayEstop) {
