@@ -66,6 +66,10 @@ class Estimator {
   // True while a low-speed fallback, not this estimator, gives the angle (LowSpeedHandover below
   // its minimum speed): the measurement window counts those samples.
   virtual bool on_fallback() const { return false; }
+  // True once the estimator's own speed has been seen falling away from the shaft's (a low-speed
+  // handover gave the angle back to the encoder while the shaft still turned above the take-over
+  // speed): the drive's lock guard counts it as a lost rotor.
+  virtual bool slipped() const { return false; }
   // Takes over the given angle and speed (a handover from another position source).
   virtual void align(double /*theta_e_rad*/, double /*omega_e_rad_s*/) {}
   // True while the drive's lock guard has taken the angle from the encoder (LockGuard); rearm()

@@ -22,6 +22,10 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
     fallback_speed_.reset(main_speed_.update(o.omega_e_rad_s));
     if (std::fabs(main_speed_.value()) < min_ - 2.0 * hyst_) {
       main_active_ = false;
+      // The encoder as the fallback tells a genuinely slower shaft from an observer slipping at
+      // its minimum speed, whose estimate falls while the shaft holds: handed to the encoder
+      // unseen, such a point kept a position error sweeping the whole half turn, unflagged.
+      if (!fallback_ && std::fabs(in.encoder_omega_e_rad_s) > min_ - hyst_) slipped_ = true;
       if (fallback_) fallback_->align(o.theta_e_rad, o.omega_e_rad_s);
     }
     return;

@@ -26,6 +26,7 @@ class LowSpeedHandover final : public Estimator {
   void fundamental(double& id_A, double& iq_A) const override;
   bool main_active() const { return main_active_; }
   bool on_fallback() const override { return !main_active_; }
+  bool slipped() const override { return slipped_; }
   bool aligning() const override { return !main_active_ && fallback_ && fallback_->aligning(); }
 
  private:
@@ -33,6 +34,7 @@ class LowSpeedHandover final : public Estimator {
   double min_, hyst_;
   LowPass main_speed_, fallback_speed_;
   bool main_active_ = false;
+  bool slipped_ = false;
   EstimatorOutput fallback_out_;
 };
 

@@ -49,7 +49,8 @@ void LockGuard::update(const EstimatorInput& in) {
   // A current vector past the guard current is the other sign of a lost rotor: the frame turns
   // against the back-EMF faster than the current loops follow (it precedes the over-current trip).
   const bool surge = guard_current_A_ > 0 && std::hypot(in.ialpha_A, in.ibeta_A) > guard_current_A_;
-  if (beyond_ >= guard_steps_ || unfound_ >= unfound_steps_ || surge) tripped_ = true;
+  const bool slipped = armed_ && inner_->slipped();
+  if (beyond_ >= guard_steps_ || unfound_ >= unfound_steps_ || surge || slipped) tripped_ = true;
 }
 
 void LockGuard::injection(double& ud_V, double& uq_V) const {

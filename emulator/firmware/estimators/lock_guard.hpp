@@ -4,8 +4,8 @@
 // own, the drive takes the angle and speed from the encoder when the estimated angle stays
 // beyond the guard angle, or the estimated speed beyond the guard speed (an observer slipping by
 // whole turns, whose wrapped angle error need not stay beyond), for the guard time, or at once
-// on a current surge, and reports it, until rearm() (the drive calls it once a changed speed or
-// angle setpoint is reached). Before it has held (an EKF converging from its initial state, HFI
+// on a current surge or when the estimator reports it slipped (Estimator::slipped), and reports
+// it, until rearm() (the drive calls it once a changed speed or angle setpoint is reached). Before it has held (an EKF converging from its initial state, HFI
 // aligning, an EEMF observer taking over on a speed ramp) only the surge counts: those cross the
 // guard on their way in and recover.
 // A slipped observer otherwise drives the current vector round a machine with ~170 V of

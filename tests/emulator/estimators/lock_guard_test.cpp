@@ -169,3 +169,45 @@ TEST(LockGuard, ACurrentSurgeTripsItAtOnce) {
 
 }  // namespace
 }  // namespace synbench::emulator::firmware
+
+namespace synbench::emulator::firmware {
+namespace {
+
+// An estimator that says it slipped (a low-speed handover that gave the angle back to the
+// encoder above the take-over speed) is a lost rotor once the guard has armed, not before.
+struct Slipping final : Estimator {
+  bool slip = false;
+  double theta = 0;
+  void update(const EstimatorInput& in) override { theta = in.encoder_theta_e_rad; }
+  EstimatorOutput output() const override {
+    EstimatorOutput o;
+    o.theta_e_rad = theta;
+    o.omega_e_rad_s = 90.0;
+    return o;
+  }
+  bool slipped() const override { return slip; }
+};
+
+TEST(LockGuard, AnEstimatorThatSlippedTripsItOnceArmed) {
+  Slipping* inner = nullptr;
+  LockGuard guard{[&inner] {
+                    auto e = std::make_unique<Slipping>();
+                    inner = e.get();
+                    return e;
+                  },
+                  45 * kDeg, 50.0, 0.002, 5.0, 1e-4};
+  EstimatorInput in;
+  in.encoder_omega_e_rad_s = 90.0;
+  inner->slip = true;
+  for (int k = 0; k < 100; ++k) guard.update(in);
+  EXPECT_FALSE(guard.lock_lost()) << "before it has held on its own";
+  inner->slip = false;
+  for (int k = 0; k < 500; ++k) guard.update(in);  // 50 ms: armed
+  EXPECT_FALSE(guard.lock_lost());
+  inner->slip = true;
+  guard.update(in);
+  EXPECT_TRUE(guard.lock_lost());
+}
+
+}  // namespace
+}  // namespace synbench::emulator::firmware
