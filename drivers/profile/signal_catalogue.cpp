@@ -70,6 +70,8 @@ constexpr SignalSpec kSynrm[] = {
     {"window_rs_est_ohm", R::window_result, false, "ohm", "estimated stator resistance, mean; not with the encoder"},
     {"window_fallback_fraction", R::window_result, false, "", "fraction of samples on the low-speed fallback source, 0..1"},
     {"window_lock_lost_fraction", R::window_result, false, "", "fraction of samples the lock guard ran on the encoder, 0..1"},
+    {"window_estimates_present", R::window_result, false, "",
+     "which estimator fields this window has, bits: 1 position and speed errors, 2 Ld, 4 Lq, 8 Rs; an absent field reads 0 (without this signal all are taken as present)"},
 };
 
 constexpr SignalSpec kLoad[] = {

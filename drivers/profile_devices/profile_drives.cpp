@@ -44,7 +44,7 @@ ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
       estimator_window_(this->profile(),
                         {"window_pos_err_min_deg", "window_pos_err_mean_deg", "window_pos_err_max_deg",
                          "window_speed_err_rpm", "window_ld_est_H", "window_lq_est_H",
-                         "window_rs_est_ohm"}) {}
+                         "window_rs_est_ohm", "window_estimates_present"}) {}
 
 std::error_code ProfileSynrmDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
 std::error_code ProfileSynrmDrive::set_speed_rpm(double v) { return io().write("speed_setpoint_rpm", v); }
@@ -109,15 +109,19 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   w.lock_lost_fraction = or_(v[15]);
   if (estimator_ != Estimator::encoder) {
     // Read after the sequence check: the next window cannot open before this bench starts it.
-    double e[7];
+    double e[8];
     if (auto ec = io().read(estimator_window_, e)) return ec;
-    w.pos_err_min_deg = opt(e[0]);
-    w.pos_err_mean_deg = opt(e[1]);
-    w.pos_err_max_deg = opt(e[2]);
-    w.speed_err_rpm = opt(e[3]);
-    w.ld_est_H = opt(e[4]);
-    w.lq_est_H = opt(e[5]);
-    w.rs_est_ohm = opt(e[6]);
+    // A register holds a number: the drive says which fields it has (a window wholly on the lock
+    // guard has no errors; EEMF-CONST no estimates). Without the signal, all are present.
+    const unsigned present = std::isnan(e[7]) ? 15u : static_cast<unsigned>(e[7]);
+    const auto field = [present](double raw, unsigned bit) { return present & bit ? opt(raw) : std::nullopt; };
+    w.pos_err_min_deg = field(e[0], 1);
+    w.pos_err_mean_deg = field(e[1], 1);
+    w.pos_err_max_deg = field(e[2], 1);
+    w.speed_err_rpm = field(e[3], 1);
+    w.ld_est_H = field(e[4], 2);
+    w.lq_est_H = field(e[5], 4);
+    w.rs_est_ohm = field(e[6], 8);
   }
   out = w;
   return {};

@@ -379,14 +379,19 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     const double c = std::cos(pos_err_rad), sn = std::sin(pos_err_rad);
     w_id_enc_.add(c * id - sn * iq);
     w_iq_enc_.add(sn * id + c * iq);
-    w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
     window_fallback_ += estimator_->on_fallback() ? 1 : 0;
     window_lock_lost_ += estimator_->lock_lost() ? 1 : 0;
-    w_speed_err_.add(speed_err_rpm);
-    const EstimatorOutput o = estimator_->output();
-    if (o.ld_H) w_ld_.add(*o.ld_H);
-    if (o.lq_H) w_lq_.add(*o.lq_H);
-    if (o.rs_ohm) w_rs_.add(*o.rs_ohm);
+    // The estimator's fields from the samples it drove: on the lock guard the angle is the
+    // encoder's (an error of exactly 0) and the estimates are the lost estimator's last ones.
+    // A window wholly on the guard leaves them empty (null in the record).
+    if (!estimator_->lock_lost()) {
+      w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
+      w_speed_err_.add(speed_err_rpm);
+      const EstimatorOutput o = estimator_->output();
+      if (o.ld_H) w_ld_.add(*o.ld_H);
+      if (o.lq_H) w_lq_.add(*o.lq_H);
+      if (o.rs_ohm) w_rs_.add(*o.rs_ohm);
+    }
   }
   if (--window_left_ > 0) return;
   drivers::SynrmWindow r;
@@ -407,11 +412,13 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   r.fallback_fraction = static_cast<double>(window_fallback_) / static_cast<double>(r.samples);
   r.lock_lost_fraction = static_cast<double>(window_lock_lost_) / static_cast<double>(r.samples);
   r.fault = state_ == drivers::DriveState::faulted ? fault_ : window_fault_;
-  if (estimator_) {
+  if (estimator_ && w_pos_err_.count()) {
     r.pos_err_min_deg = w_pos_err_.min();
     r.pos_err_mean_deg = w_pos_err_.mean();
     r.pos_err_max_deg = w_pos_err_.max();
     r.speed_err_rpm = w_speed_err_.mean();
+  }
+  if (estimator_) {
     if (w_ld_.count()) r.ld_est_H = w_ld_.mean();
     if (w_lq_.count()) r.lq_est_H = w_lq_.mean();
     if (w_rs_.count()) r.rs_est_ohm = w_rs_.mean();

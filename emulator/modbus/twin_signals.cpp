@@ -72,6 +72,8 @@ double TwinSignals::synrm_value(const std::string& n) const {
     if (n == "window_rs_est_ohm") return or0(w.rs_est_ohm);
     if (n == "window_fallback_fraction") return w.fallback_fraction;
     if (n == "window_lock_lost_fraction") return w.lock_lost_fraction;
+    if (n == "window_estimates_present")
+      return (w.pos_err_mean_deg ? 1 : 0) + (w.ld_est_H ? 2 : 0) + (w.lq_est_H ? 4 : 0) + (w.rs_est_ohm ? 8 : 0);
     return 0;
   }
   const drivers::SynrmTelemetry t = fw.telemetry();

@@ -188,15 +188,23 @@ TEST(SweepEngine, HfiFindsTheRotorAfterAConfigurationSwitch) {
   run.until(e, 3600);
   ASSERT_EQ(e.state(), SweepState::completed) << e.error();
   ASSERT_EQ(sink.points.size(), 2u * 3u * 19u);
-  int hfi = 0;
+  int hfi = 0, guarded = 0;
   for (const auto& [index, r] : sink.points) {
     if (r.estimator != drivers::Estimator::hfi) continue;
     ++hfi;
     EXPECT_FALSE(r.fault) << index;
+    // A point the lock guard ran on the encoder has no position error to check (3.5 N m, 76 deg,
+    // the grid's hardest for HFI; the thesis sweep guards it too); the first, after the switch,
+    // must hold.
+    if (r.lock_lost && hfi > 1) {
+      ++guarded;
+      continue;
+    }
     ASSERT_TRUE(r.pos_err_min_deg && r.pos_err_max_deg) << index;
     EXPECT_LT(*r.pos_err_max_deg - *r.pos_err_min_deg, 90.0) << index << ": out of lock";
   }
   EXPECT_EQ(hfi, 2 * 19);
+  EXPECT_LE(guarded, 1);
 }
 
 // Between configurations the engine removes the load at the bench's ramp (2 N m/s), as between

@@ -401,6 +401,13 @@ TEST(ClosedLoopEstimators, TheLockGuardHandsBackOnceTheNewSetpointsAreReached) {
   emulator::Twin tw{emulator::TwinConfig{}};
   auto& d = tw.synrm_drive();
   ASSERT_NO_FATAL_FAILURE(lose_the_rotor_at_76_deg(tw, drivers::Estimator::eemf_lut, 500, 2.0));
+  // A window wholly on the guard has no estimator fields: its angle is the encoder's (an error
+  // of exactly 0, which a record would show as a perfect estimate).
+  d.begin_window(2000);
+  run_s(tw, 0.25);
+  const auto w = d.window_result();
+  EXPECT_EQ(w.lock_lost_fraction, 1.0);
+  EXPECT_FALSE(w.pos_err_mean_deg || w.pos_err_min_deg || w.pos_err_max_deg || w.speed_err_rpm);
   ASSERT_FALSE(d.set_angle_deg(40));  // 36 deg at 30 deg/s: 1.2 s of slewing
   run_s(tw, 1.0);
   EXPECT_TRUE(d.telemetry().lock_lost) << "handed back before the angle reached 40 deg";

@@ -3,6 +3,9 @@
 // sequence numbers, and mode changes refused while running.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "drivers/error.hpp"
 #include "drivers/profile_devices/profile_bench.hpp"
 #include "emulator/modbus/modbus_pdu.hpp"
@@ -119,6 +122,39 @@ TEST_F(TwinFixture, OneWindowOnAllThreeDevices) {
   for (auto k : drivers::kDeviceKinds) {
     EXPECT_EQ(seq(k).status, 2);
     EXPECT_EQ(seq(k).sequence, 1);
+  }
+}
+
+// Through the register map a window reports which estimator fields it has, as the in-process
+// drive does with empty fields: EKF-BASIC estimates Ld and Lq but not Rs, EEMF-CONST none of them.
+// Read as numbers alone, the missing ones arrived as 0 H and 0 ohm.
+TEST_F(TwinFixture, TheWindowSaysWhichEstimatorFieldsItHas) {
+  struct Case {
+    drivers::Estimator e;
+    drivers::Pwm pwm;
+    bool inductances;
+  };
+  for (const Case c : {Case{drivers::Estimator::ekf_basic, drivers::Pwm::aspwm, true},
+                       Case{drivers::Estimator::eemf_const, drivers::Pwm::capwm, false}}) {
+    const std::string at(drivers::name(c.e));
+    ASSERT_FALSE(bench.synrm().enable(false)) << at;
+    bench.clock().wait_until(clock.now_s() + 2.0);
+    ASSERT_FALSE(bench.synrm().set_pwm(c.pwm)) << at;
+    ASSERT_FALSE(bench.synrm().set_estimator(c.e)) << at;
+    spin_up(700);
+    bench.clock().wait_until(clock.now_s() + 1.0);
+    ASSERT_FALSE(bench.trigger().open_window(0.5)) << at;
+    while (!bench.trigger().window_closed()) bench.clock().wait_until(clock.now_s() + 0.01);
+    drivers::SynrmWindow w;
+    ASSERT_FALSE(bench.synrm().read_window(w)) << at;
+    ASSERT_TRUE(w.pos_err_mean_deg && w.pos_err_min_deg && w.pos_err_max_deg && w.speed_err_rpm) << at;
+    EXPECT_LT(std::fabs(*w.pos_err_mean_deg), 20.0) << at;
+    EXPECT_EQ(w.ld_est_H.has_value(), c.inductances) << at;
+    EXPECT_EQ(w.lq_est_H.has_value(), c.inductances) << at;
+    if (w.ld_est_H) {
+      EXPECT_GT(*w.ld_est_H, 0.1) << at;
+    }
+    EXPECT_FALSE(w.rs_est_ohm) << at << ": " << w.rs_est_ohm.value_or(0);
   }
 }
 
