@@ -28,7 +28,7 @@ struct SynrmTelemetry {
   double temp_C = 0;
   bool voltage_limited = false;
   // Estimated minus encoder electrical angle, wrapped to (-90, 90] deg, at the last control
-  // period; empty when the encoder is the position source.
+  // period; empty when the encoder is the position source, and while the lock guard holds.
   std::optional<double> pos_err_deg;
   // The drive's lock guard took the angle from a sensorless estimator that left the encoder's
   // (a slipped observer) and runs on the encoder until a changed speed or angle setpoint is

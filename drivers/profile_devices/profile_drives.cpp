@@ -83,9 +83,10 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   out.pac_W = or_(v[9]);
   out.temp_C = or_(v[10]);
   out.voltage_limited = or_(v[11]) != 0;
-  // The register reads 0 with the encoder; a profile without it leaves the field empty.
-  out.pos_err_deg = estimator_ != Estimator::encoder ? opt(v[12]) : std::nullopt;
+  // The register reads 0 with the encoder and on the lock guard; a profile without it leaves the
+  // field empty.
   out.lock_lost = or_(v[13]) != 0;
+  out.pos_err_deg = estimator_ != Estimator::encoder && !out.lock_lost ? opt(v[12]) : std::nullopt;
   return {};
 }
 

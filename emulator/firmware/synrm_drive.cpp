@@ -444,8 +444,9 @@ drivers::SynrmTelemetry SynrmDriveFirmware::telemetry() const {
   t.pac_W = f_pac_.value();
   t.temp_C = f_temp_.value();
   t.voltage_limited = limited_hold_s_ > 0;
-  if (estimator_) t.pos_err_deg = pos_err_deg_;
   t.lock_lost = estimator_ && estimator_->lock_lost();
+  // On the lock guard the angle is the encoder's: no estimator error to show.
+  if (estimator_ && !t.lock_lost) t.pos_err_deg = pos_err_deg_;
   t.state = state_;
   t.fault = fault_;
   return t;

@@ -403,6 +403,7 @@ TEST(ClosedLoopEstimators, TheLockGuardHandsBackOnceTheNewSetpointsAreReached) {
   ASSERT_NO_FATAL_FAILURE(lose_the_rotor_at_76_deg(tw, drivers::Estimator::eemf_lut, 500, 2.0));
   // A window wholly on the guard has no estimator fields: its angle is the encoder's (an error
   // of exactly 0, which a record would show as a perfect estimate).
+  EXPECT_FALSE(d.telemetry().pos_err_deg) << "the guard's angle is the encoder's";
   d.begin_window(2000);
   run_s(tw, 0.25);
   const auto w = d.window_result();
