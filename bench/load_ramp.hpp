@@ -8,6 +8,9 @@
 
 namespace synbench::bench {
 
+// The bench's rate (PointOptions, a user's disable).
+inline constexpr double kBenchLoadRamp_Nm_per_s = 2.0;
+
 class LoadRamp {
  public:
   explicit LoadRamp(double rate_Nm_per_s) : rate_(rate_Nm_per_s) {}

@@ -4,13 +4,6 @@
 #include <cmath>
 
 namespace synbench::bench {
-namespace {
-
-bool running(drivers::DriveState s) {
-  return s == drivers::DriveState::running || s == drivers::DriveState::stopping;
-}
-
-}  // namespace
 
 void OrderedStop::begin(const drivers::BenchDevices& dev, const OrderedStopOptions& opt,
                         double now_s, double from_Nm) {
@@ -52,7 +45,7 @@ bool OrderedStop::tick(double now_s, const std::optional<drivers::SynrmTelemetry
     case StopStep::speed: {
       dev_.synrm->set_speed_rpm(0.0);
       const bool still = synrm && std::fabs(synrm->speed_rpm) < opt_.stopped_speed_rpm;
-      const bool off = synrm && !running(synrm->state);
+      const bool off = synrm && !drivers::running(synrm->state);
       if (!still && !off) {
         if (now_s - step_since_s_ <= opt_.speed_timeout_s) return false;
         timed_out_ = true;

@@ -43,7 +43,7 @@ struct PointOptions {
   // must track the deceleration the load change causes until the 3 Hz speed loop answers: a
   // 2.5 N m step (ramped by the load drive within 0.25 s) stalled EEMF-LUT at 700 rpm, 56 deg
   // (a PI tracking loop lags an acceleration alpha by alpha / wn^2), 2 N m/s did not.
-  double load_ramp_Nm_per_s = 2.0;
+  double load_ramp_Nm_per_s = kBenchLoadRamp_Nm_per_s;
   // A sensorless point started from rest [ours] spins up and takes its load at no more than
   // `sensorless_start_angle_deg`, moving to its own angle once loaded (0: its own from the
   // start), and its load comes from `sensorless_load_at_speed_fraction` of the speed on instead

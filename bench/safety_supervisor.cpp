@@ -15,10 +15,6 @@ std::string format(const char* fmt, double a, double b) {
   return buf;
 }
 
-bool running(drivers::DriveState s) {
-  return s == drivers::DriveState::running || s == drivers::DriveState::stopping;
-}
-
 }  // namespace
 
 SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits,
@@ -97,7 +93,7 @@ void SafetySupervisor::tick(double now_s) {
       raise(now_s, drivers::Fault::overcurrent, format("current %.2f A > %.2f A", s.im_A, lim_.max_current_A));
     else if (s.udc_V > lim_.max_udc_V)
       raise(now_s, drivers::Fault::overvoltage, format("DC bus %.0f V > %.0f V", s.udc_V, lim_.max_udc_V));
-    else if (running(s.state) && s.udc_V < lim_.min_udc_V)
+    else if (drivers::running(s.state) && s.udc_V < lim_.min_udc_V)
       raise(now_s, drivers::Fault::undervoltage, format("DC bus %.0f V < %.0f V", s.udc_V, lim_.min_udc_V));
     else if (s.temp_C > lim_.max_temp_C)
       raise(now_s, drivers::Fault::overtemperature, format("winding %.1f degC > %.1f degC", s.temp_C, lim_.max_temp_C));

@@ -15,6 +15,9 @@ namespace synbench::drivers {
 
 enum class DriveState : std::uint16_t { disabled = 0, running = 1, stopping = 2, faulted = 3 };
 
+// Gates on: running, or in the drive's own ordered stop.
+inline bool running(DriveState s) { return s == DriveState::running || s == DriveState::stopping; }
+
 // Filtered live values of the SynRM drive (controller frame for d, q).
 struct SynrmTelemetry {
   double speed_rpm = 0;

@@ -379,12 +379,13 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     const double c = std::cos(pos_err_rad), sn = std::sin(pos_err_rad);
     w_id_enc_.add(c * id - sn * iq);
     w_iq_enc_.add(sn * id + c * iq);
+    const bool lost = estimator_->lock_lost();
     window_fallback_ += estimator_->on_fallback() ? 1 : 0;
-    window_lock_lost_ += estimator_->lock_lost() ? 1 : 0;
+    window_lock_lost_ += lost ? 1 : 0;
     // The estimator's fields from the samples it drove: on the lock guard the angle is the
     // encoder's (an error of exactly 0) and the estimates are the lost estimator's last ones.
     // A window wholly on the guard leaves them empty (null in the record).
-    if (!estimator_->lock_lost()) {
+    if (!lost) {
       w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
       w_speed_err_.add(speed_err_rpm);
       const EstimatorOutput o = estimator_->output();

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "bench/point_procedure.hpp"
+#include "bench/load_ramp.hpp"
 
 namespace synbench::http {
 
@@ -192,7 +192,7 @@ std::optional<Refusal> BenchRuntime::enable(bool on) {
   // At the bench's ramp, as a sweep's stop: a sensorless drive at a high current angle must
   // follow the acceleration.
   bench::OrderedStopOptions opt;
-  opt.load_ramp_Nm_per_s = bench::PointOptions{}.load_ramp_Nm_per_s;
+  opt.load_ramp_Nm_per_s = bench::kBenchLoadRamp_Nm_per_s;
   const auto& lt = supervisor_->load();
   stop_.begin(dev, opt, backend_->clock().now_s(), lt ? lt->torque_Nm : setpoints_.load_Nm);
   event_locked("stop", "ordered stop requested");
