@@ -187,6 +187,10 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("estimators.eemf.lut_lq_scale", &e.lut_lq_scale, "Sec. 4 (4.2)", "EEMF-LUT table deformation kq (1 = exact tables)");
   b.choice("estimators.eemf.lut_rotation_speed", &e.lut_rotation_speed, {"observer", "active-flux"}, "Sec. 6.2.3",
            "EEMF-LUT: rotor speed in the w Lq terms and the derivative's frame, the tracking observer's (the thesis; EEMF-CONST and EEMF-RLS always) or the active flux's (ours, docs/estimators.md)");
+  b.choice("estimators.eemf.error_signal", &e.error_signal, {"direction", "vector"}, "Sec. 6.2.3",
+           "EEMF-LUT and EEMF-RLS: the angle error from the EEMF's direction only (the thesis) or from its whole vector, the magnitude against the model's prediction as well (ours, docs/estimators.md; EEMF-CONST always the direction)");
+  b.num("estimators.eemf.rls_emf_scale_filter_s", &e.rls_emf_scale_filter_s, 0, 100, "assumed",
+        "EEMF-RLS with the vector error: time constant over which the predicted EEMF magnitude is scaled to the measured one (the identified inductances miss the saturated d axis' flux offset; 0: not scaled)", A);
   b.num("estimators.eemf.flux_blend_rad_s", &e.flux_blend_rad_s, 0, 1000, "assumed",
         "active-flux speed: below this the voltage model's flux is pulled to the model's at the estimated angle", A);
   b.num("estimators.eemf.flux_speed_filter_s", &e.flux_speed_filter_s, 0, 1, "assumed",

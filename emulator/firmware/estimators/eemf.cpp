@@ -18,6 +18,9 @@ Eemf::Eemf(const EemfParams& p)
   ig_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   id_f_.configure(10 * p_.emf_filter_s, p_.ts_s);
   ed_f_.configure(p_.emf_filter_s, p_.ts_s);
+  e0_f_.configure(p_.emf_filter_s, p_.ts_s);
+  k_f_.configure(p_.emf_filter_s, p_.ts_s);
+  scale_.configure(p_.emf_scale_filter_s, p_.ts_s);
   speed_f_.configure(p_.speed_filter_s, p_.ts_s);
   if (p_.model == EemfModel::rls) {
     rls_every_ = std::max(1, static_cast<int>(std::lround(p_.rls_sample_s / p_.ts_s)));
@@ -59,6 +62,19 @@ Eemf::Flux Eemf::model_flux(double ig, double id) const {
       return {ld_dyn * ig, lq * id, lq};
   }
   return {};
+}
+
+EmfPrediction Eemf::predict(double ig_s, double id_s, double ld_dyn, double lq_static, double w_rot,
+                            double did) const {
+  // E = w (Psi_d(i_d) - Lq i_d) - (L'd - L'q) p i_q on the q axis: the measured e_d carries the
+  // machine's L'q p i_q against the model's L'd p i_q.
+  double psi_d = ld_dyn * ig_s, lq_dyn = lq_static;
+  if (p_.model == EemfModel::lut) {
+    psi_d = lut_static_H(fd_, p_.lut_ld_scale, ig_s) * ig_s;
+    lq_dyn = p_.lut_lq_scale * fq_.dynamic_inductance_H(id_s / p_.lut_lq_scale);
+  }
+  return {w_rot * (psi_d - lq_static * ig_s) - (ld_dyn - lq_dyn) * did,
+          w_rot * (ld_dyn - lq_static) * id_s};
 }
 
 void Eemf::update_flux_speed(const EstimatorInput& in, double th, double ig, double id,
@@ -151,14 +167,14 @@ void Eemf::update(const EstimatorInput& in) {
   have_prev_ = true;
   const double eg = eg_f_.update(ug - rs * ig - ld_dyn * dig + w_rot * lq * id);
   const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w_rot * lq * ig);
-  // The angle error from the EEMF's line, not its arrow [assumed]: atan(-e_g / e_d), modulo
-  // 180 deg. The EEMF (Ld - Lq)(w i_d - p i_q) lies on the q axis but flips its sign when a q-current
-  // transient outruns w i_d (high current angle, low speed): atan2 then reads an error near 180 deg
-  // and the observer runs away. A SynRM does not care about 180 deg. The error is weighted by
-  // |e|^2 / (|e|^2 + e0^2) so that a vanishing EEMF (no current, noise only) does not steer it.
-  const double e2 = eg * eg + ed * ed;
-  const double e0 = p_.emf_floor_V;
-  const double err = 0.5 * std::atan2(-2.0 * eg * ed, ed * ed - eg * eg) * (e2 / (e2 + e0 * e0));
+  double err = 0.0;
+  if (p_.vector_error) {
+    EmfPrediction m = predict(ig_f_.value(), id_f_.value(), ld_dyn, lq, w_rot, did);
+    m = scale_.update(ed, {e0_f_.update(m.emf_V), k_f_.update(m.slope_V_per_rad)});
+    err = emf_vector_angle_error(eg, ed, m, p_.emf_floor_V);
+  } else {
+    err = emf_line_angle_error(eg, ed, p_.emf_floor_V);
+  }
   obs_.correct(err, ts);
   speed_f_.update(obs_.speed());
   tuner_.update(obs_, ig, id);

@@ -1,6 +1,7 @@
 // Extended-EMF observer (physics.md 8, thesis 2.12, 2.13, Sec. 6.2.3): in the estimated frame
 // e_g = u_g - (Rs + L'd p) i_g + w Lq i_d, e_d = u_d - (Rs + L'd p) i_d - w Lq i_g; the angle
-// error atan2(-e_g, e_d) drives a PI tracking observer (5 Hz, raised where the shaft makes an
+// error atan2(-e_g, e_d) (or, [ours], the whole EEMF vector against the model's prediction:
+// emf_angle_error.hpp) drives a PI tracking observer (5 Hz, raised where the shaft makes an
 // angle error grow) whose integral is the angle; p i is taken in a frame turning at the estimated
 // rotor speed, and the reported speed (the PI's output) is low-passed. The rotor speed in those
 // rotation terms is the observer's integrator (the thesis) or the active flux's
@@ -13,6 +14,7 @@
 #include <optional>
 
 #include "emulator/firmware/estimators/active_flux_speed.hpp"
+#include "emulator/firmware/estimators/emf_angle_error.hpp"
 #include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/estimators/rls.hpp"
 #include "emulator/firmware/estimators/shaft_stiffness.hpp"
@@ -45,6 +47,10 @@ struct EemfParams {
   double speed_filter_s = 0.0;          // [assumed] low-pass on the reported speed (0: none)
   double emf_filter_s = 5e-3;           // [assumed] low-pass on e before the angle error
   double emf_floor_V = 5.0;             // [assumed] |e| below which the angle error is faded out
+  // [ours] The angle error from the whole EEMF vector, its magnitude against the model's
+  // prediction as well (emf_angle_error.hpp); false: from its direction only (the thesis).
+  bool vector_error = false;
+  double emf_scale_filter_s = 0.0;      // [assumed] EmfScale time constant (0: the model as is)
   EemfRotationSpeed rotation_speed = EemfRotationSpeed::observer;
   ActiveFluxSpeedParams flux_speed;     // for EemfRotationSpeed::active_flux
   double rls_forgetting = 0.99;         // Sec. 6.2.3
@@ -82,12 +88,17 @@ class Eemf final : public Estimator {
     double psi_g_Wb, psi_d_Wb, lq_static_H;
   };
   Flux model_flux(double ig, double id) const;
+  // The model's EEMF at zero angle error and its slope, at the smoothed currents, before the EMF
+  // filter (which the caller applies as to e).
+  EmfPrediction predict(double ig_s, double id_s, double ld_dyn, double lq_static, double w_rot,
+                        double did) const;
   void update_flux_speed(const EstimatorInput& in, double th, double ig, double id, double rs);
 
   EemfParams p_;
   FluxAxis fd_, fq_;
   TrackingObserver obs_;
-  LowPass eg_f_, ed_f_, ig_f_, id_f_;
+  LowPass eg_f_, ed_f_, ig_f_, id_f_, e0_f_, k_f_;
+  EmfScale scale_;
   StiffnessTuner tuner_;
   LowPass speed_f_;
   ActiveFluxSpeed flux_speed_;

@@ -58,6 +58,10 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   p.rotation_speed = model == EemfModel::lut && e.lut_rotation_speed == "active-flux"
                          ? EemfRotationSpeed::active_flux
                          : EemfRotationSpeed::observer;
+  // The magnitude needs a model of it: the tables have one, the RLS its slope (scaled to the
+  // measurement), the constants neither (emf_angle_error.hpp).
+  p.vector_error = model != EemfModel::constant && e.error_signal == "vector";
+  p.emf_scale_filter_s = model == EemfModel::rls ? e.rls_emf_scale_filter_s : 0.0;
   p.flux_speed.blend_rad_s = e.flux_blend_rad_s;
   p.flux_speed.speed_filter_s = e.flux_speed_filter_s;
   p.rls_forgetting = e.rls_forgetting;
