@@ -64,17 +64,15 @@ Eemf::Flux Eemf::model_flux(double ig, double id) const {
   return {};
 }
 
-EmfPrediction Eemf::predict(double ig_s, double id_s, double ld_dyn, double lq_static, double w_rot,
-                            double did) const {
+EmfPrediction Eemf::predict(double ig_s, double id_s, double ld_dyn, double w_rot, double did) const {
   // E = w (Psi_d(i_d) - Lq i_d) - (L'd - L'q) p i_q on the q axis: the measured e_d carries the
   // machine's L'q p i_q against the model's L'd p i_q.
-  double psi_d = ld_dyn * ig_s, lq_dyn = lq_static;
-  if (p_.model == EemfModel::lut) {
-    psi_d = lut_static_H(fd_, p_.lut_ld_scale, ig_s) * ig_s;
-    lq_dyn = p_.lut_lq_scale * fq_.dynamic_inductance_H(id_s / p_.lut_lq_scale);
-  }
-  return {w_rot * (psi_d - lq_static * ig_s) - (ld_dyn - lq_dyn) * did,
-          w_rot * (ld_dyn - lq_static) * id_s};
+  const Flux f = model_flux(ig_s, id_s);
+  const double lq_dyn = p_.model == EemfModel::lut
+                            ? p_.lut_lq_scale * fq_.dynamic_inductance_H(id_s / p_.lut_lq_scale)
+                            : f.lq_static_H;
+  return {w_rot * (f.psi_g_Wb - f.lq_static_H * ig_s) - (ld_dyn - lq_dyn) * did,
+          w_rot * (ld_dyn - f.lq_static_H) * id_s};
 }
 
 void Eemf::update_flux_speed(const EstimatorInput& in, double th, double ig, double id,
@@ -169,7 +167,7 @@ void Eemf::update(const EstimatorInput& in) {
   const double ed = ed_f_.update(ud - rs * id - ld_dyn * did - w_rot * lq * ig);
   double err = 0.0;
   if (p_.vector_error) {
-    EmfPrediction m = predict(ig_f_.value(), id_f_.value(), ld_dyn, lq, w_rot, did);
+    EmfPrediction m = predict(ig_f_.value(), id_f_.value(), ld_dyn, w_rot, did);
     m = scale_.update(ed, {e0_f_.update(m.emf_V), k_f_.update(m.slope_V_per_rad)});
     err = emf_vector_angle_error(eg, ed, m, p_.emf_floor_V);
   } else {

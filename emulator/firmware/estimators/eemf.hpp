@@ -88,10 +88,9 @@ class Eemf final : public Estimator {
     double psi_g_Wb, psi_d_Wb, lq_static_H;
   };
   Flux model_flux(double ig, double id) const;
-  // The model's EEMF at zero angle error and its slope, at the smoothed currents, before the EMF
-  // filter (which the caller applies as to e).
-  EmfPrediction predict(double ig_s, double id_s, double ld_dyn, double lq_static, double w_rot,
-                        double did) const;
+  // The model's EEMF at zero angle error and its slope, from its flux at the smoothed currents,
+  // before the EMF filter (which the caller applies as to e).
+  EmfPrediction predict(double ig_s, double id_s, double ld_dyn, double w_rot, double did) const;
   void update_flux_speed(const EstimatorInput& in, double th, double ig, double id, double rs);
 
   EemfParams p_;
