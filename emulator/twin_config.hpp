@@ -145,13 +145,15 @@ struct EemfConfig {
   double rls_forgetting = 0.99;
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;
-  double rls_estimate_filter_s = 0.2;  // low-pass on the estimates the observer uses
+  double rls_estimate_filter_s = 0.2;  // low-pass on the estimates reported
+  double rls_model_filter_s = 2.0;     // low-pass on the estimates the observer uses
   double rls_warmup_s = 0.3;           // identification time before the observer uses it
   std::string lut_rotation_speed = "observer";  // the thesis; or "active-flux" [ours]
   // EEMF-LUT and EEMF-RLS: the angle error from the EEMF's "direction" (the thesis) or its whole
   // "vector" against the model's magnitude [ours]; EEMF-CONST always the direction.
   std::string error_signal = "vector";
   double rls_emf_scale_filter_s = 0.2;  // EEMF-RLS: the predicted magnitude scaled to the measured
+  bool rls_flux_offset = true;  // EEMF-RLS: static flux from the identified flux offsets [ours]
   double flux_blend_rad_s = 5.0;
   double flux_speed_filter_s = 0.015;
   double prbs_voltage_V = 20.0;

@@ -191,6 +191,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
            "EEMF-LUT and EEMF-RLS: the angle error from the EEMF's direction only (the thesis) or from its whole vector, the magnitude against the model's prediction as well (ours, docs/estimators.md; EEMF-CONST always the direction)");
   b.num("estimators.eemf.rls_emf_scale_filter_s", &e.rls_emf_scale_filter_s, 0, 100, "assumed",
         "EEMF-RLS with the vector error: time constant over which the predicted EEMF magnitude is scaled to the measured one (the identified inductances miss the saturated d axis' flux offset; 0: not scaled)", A);
+  b.flag("estimators.eemf.rls_flux_offset", &e.rls_flux_offset, "assumed",
+         "EEMF-RLS: the static flux of the rotation terms and of the magnitude prediction from the identified inductances plus the flux offsets of the RLS's affine part (ours, docs/estimators.md; false: the incremental inductances alone)", A);
   b.num("estimators.eemf.flux_blend_rad_s", &e.flux_blend_rad_s, 0, 1000, "assumed",
         "active-flux speed: below this the voltage model's flux is pulled to the model's at the estimated angle", A);
   b.num("estimators.eemf.flux_speed_filter_s", &e.flux_speed_filter_s, 0, 1, "assumed",
@@ -199,7 +201,9 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("estimators.eemf.rls_p0", &e.rls_p0, "Sec. 6.2.3", "RLS initial covariance diagonal");
   b.num("estimators.eemf.rls_sample_s", &e.rls_sample_s, 1e-5, 0.1, "assumed", "RLS sample period", A);
   b.num("estimators.eemf.rls_estimate_filter_s", &e.rls_estimate_filter_s, 0, 100, "assumed",
-        "low-pass time constant on the RLS estimates the observer uses", A);
+        "low-pass time constant on the RLS estimates the drive reports", A);
+  b.num("estimators.eemf.rls_model_filter_s", &e.rls_model_filter_s, 0, 100, "assumed",
+        "low-pass time constant on the RLS estimates the EEMF observer uses (slower than the reported ones: identified in the estimated frame they move with the observer's angle error; docs/estimators.md)", A);
   b.num("estimators.eemf.rls_warmup_s", &e.rls_warmup_s, 0, 100, "assumed",
         "identification time before the observer takes the RLS estimates (the constants until then)", A);
   b.num("estimators.eemf.prbs_voltage_V", &e.prbs_voltage_V, 0, 100, "Sec. 6.2.3", "PRBS amplitude on both axes");

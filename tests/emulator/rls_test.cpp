@@ -69,6 +69,9 @@ TEST(StatorRls, IdentifiesRsAndTheInductancesFromClosedLoopData) {
   EXPECT_NEAR(e->rs_ohm, rs, 0.1 * rs);
   EXPECT_NEAR(e->ld_H, ld, 0.1 * ld);
   EXPECT_NEAR(e->lq_H, lq, 0.1 * lq);
+  // w J psi_off: the q offset's back-EMF on the d axis, nothing on q.
+  EXPECT_NEAR(e->offset_g_V, -we * psi_q0, 0.1 * we * psi_q0);
+  EXPECT_NEAR(e->offset_d_V, 0.0, 0.05 * we * psi_q0);
 }
 
 }  // namespace

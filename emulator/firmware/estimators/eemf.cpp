@@ -44,8 +44,10 @@ void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) 
       return;
     }
     case EemfModel::rls:
-      ld_dyn = estimate_ ? estimate_->ld_H : p_.ld_H;
-      lq_static = estimate_ ? estimate_->lq_H : p_.lq_H;
+      ld_dyn = model_ ? model_->ld_H : p_.ld_H;
+      lq_static = model_ ? model_->lq_H : p_.lq_H;
+      // psi_q = L'q i_q + psi_off_q, faded out toward zero q current where it means nothing.
+      if (model_) lq_static += model_->psi_off_d_Wb * id / (id * id + 0.01);
       return;
   }
 }
@@ -57,9 +59,11 @@ Eemf::Flux Eemf::model_flux(double ig, double id) const {
       lq = lut_static_H(fq_, p_.lut_lq_scale, id);
       return {lut_static_H(fd_, p_.lut_ld_scale, ig) * ig, lq * id, lq};
     case EemfModel::constant:
-    case EemfModel::rls:
-      inductances(ig, id, ld_dyn, lq);  // linear: no current dependence
+      inductances(ig, id, ld_dyn, lq);
       return {ld_dyn * ig, lq * id, lq};
+    case EemfModel::rls:
+      inductances(ig, id, ld_dyn, lq);
+      return {ld_dyn * ig + (model_ ? model_->psi_off_g_Wb : 0.0), lq * id, lq};
   }
   return {};
 }
@@ -68,9 +72,11 @@ EmfPrediction Eemf::predict(double ig_s, double id_s, double ld_dyn, double w_ro
   // E = w (Psi_d(i_d) - Lq i_d) - (L'd - L'q) p i_q on the q axis: the measured e_d carries the
   // machine's L'q p i_q against the model's L'd p i_q.
   const Flux f = model_flux(ig_s, id_s);
-  const double lq_dyn = p_.model == EemfModel::lut
-                            ? p_.lut_lq_scale * fq_.dynamic_inductance_H(id_s / p_.lut_lq_scale)
-                            : f.lq_static_H;
+  double lq_dyn = f.lq_static_H;
+  if (p_.model == EemfModel::lut)
+    lq_dyn = p_.lut_lq_scale * fq_.dynamic_inductance_H(id_s / p_.lut_lq_scale);
+  else if (p_.model == EemfModel::rls && model_)
+    lq_dyn = model_->lq_H;
   return {w_rot * (f.psi_g_Wb - f.lq_static_H * ig_s) - (ld_dyn - lq_dyn) * did,
           w_rot * (ld_dyn - f.lq_static_H) * id_s};
 }
@@ -119,14 +125,7 @@ void Eemf::update(const EstimatorInput& in) {
       const auto e = rls_->estimate();
       const bool plausible = e && e->rs_ohm > 0 && e->rs_ohm < 5 * p_.rs_ohm && e->ld_H > 0.01 &&
                              e->lq_H > 0.01 && e->ld_H < 2 && e->lq_H < 2;
-      if (plausible && rls_intervals_ >= rls_warmup_intervals_) {
-        // From the constants the observer ran on, not a step onto the first fit.
-        if (!estimate_) estimate_ = StatorEstimate{p_.rs_ohm, p_.ld_H, p_.lq_H};
-        const double a = p_.rls_sample_s / (p_.rls_estimate_filter_s + p_.rls_sample_s);
-        estimate_->rs_ohm += a * (e->rs_ohm - estimate_->rs_ohm);
-        estimate_->ld_H += a * (e->ld_H - estimate_->ld_H);
-        estimate_->lq_H += a * (e->lq_H - estimate_->lq_H);
-      }
+      if (plausible && rls_intervals_ >= rls_warmup_intervals_) take_rls_fit(*e, w);
       rls_ig0_ = ig;
       rls_id0_ = id;
       rls_have_prev_ = true;
@@ -140,7 +139,7 @@ void Eemf::update(const EstimatorInput& in) {
   double ld_dyn, lq;
   // Table look-ups on smoothed currents: noise must not modulate the inductances.
   inductances(ig_f_.update(ig), id_f_.update(id), ld_dyn, lq);
-  const double rs = (p_.model == EemfModel::rls && estimate_) ? estimate_->rs_ohm : p_.rs_ohm;
+  const double rs = model_ ? model_->rs_ohm : p_.rs_ohm;
   double w_rot = w;
   if (p_.rotation_speed == EemfRotationSpeed::active_flux) {
     update_flux_speed(in, th, ig, id, rs);
@@ -176,6 +175,29 @@ void Eemf::update(const EstimatorInput& in) {
   obs_.correct(err, ts);
   speed_f_.update(obs_.speed());
   tuner_.update(obs_, ig, id);
+}
+
+void Eemf::take_rls_fit(const StatorEstimate& e, double w) {
+  // From the constants the observer ran on, not a step onto the first fit.
+  if (!estimate_) {
+    estimate_ = StatorEstimate{p_.rs_ohm, p_.ld_H, p_.lq_H};
+    model_ = RlsModel{p_.rs_ohm, p_.ld_H, p_.lq_H};
+  }
+  const auto toward = [this](double& x, double target, double tau_s) {
+    x += p_.rls_sample_s / (tau_s + p_.rls_sample_s) * (target - x);
+  };
+  toward(estimate_->rs_ohm, e.rs_ohm, p_.rls_estimate_filter_s);
+  toward(estimate_->ld_H, e.ld_H, p_.rls_estimate_filter_s);
+  toward(estimate_->lq_H, e.lq_H, p_.rls_estimate_filter_s);
+  const double tau = p_.rls_model_filter_s;
+  toward(model_->rs_ohm, e.rs_ohm, tau);
+  toward(model_->ld_H, e.ld_H, tau);
+  toward(model_->lq_H, e.lq_H, tau);
+  // The offset EMF is w J psi_off in the frame the RLS identified in, at the speed it turned at.
+  if (p_.rls_flux_offset && std::fabs(w) > 20.0) {
+    toward(model_->psi_off_g_Wb, e.offset_d_V / w, tau);
+    toward(model_->psi_off_d_Wb, -e.offset_g_V / w, tau);
+  }
 }
 
 EstimatorOutput Eemf::output() const {

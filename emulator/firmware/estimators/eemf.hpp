@@ -56,10 +56,18 @@ struct EemfParams {
   double rls_forgetting = 0.99;         // Sec. 6.2.3
   double rls_p0 = 1e5;
   double rls_sample_s = 1e-3;           // [assumed] RLS sample period (a multiple of ts_s)
-  double rls_estimate_filter_s = 0.2;   // [assumed] low-pass on the estimates the observer uses
+  double rls_estimate_filter_s = 0.2;   // [assumed] low-pass on the estimates reported
+  // [assumed] Low-pass on the estimates the observer uses: much slower than the identification
+  // (docs/estimators.md): identified in the estimated frame, they move with the observer's own
+  // angle error, and followed closely that loop lost the rotor at high current angles.
+  double rls_model_filter_s = 2.0;
   // [assumed] The observer runs on the constants until the RLS has identified this long: from
   // P0 = 1e5 I its first estimates are whatever the first few intervals fit.
   double rls_warmup_s = 0.3;
+  // [ours] The RLS's flux offsets (its affine part, rls.hpp) complete its linear model into the
+  // static flux the rotation terms and the magnitude prediction need: Lq = L'q + psi_off_q / i_q,
+  // Psi_d = L'd i_d + psi_off_d. false: the incremental inductances as they are (the thesis).
+  bool rls_flux_offset = true;
   double prbs_voltage_V = 20.0;         // Sec. 6.2.3
   double prbs_bit_s = 0.01;
 };
@@ -105,7 +113,14 @@ class Eemf final : public Estimator {
   bool have_prev_ = false;
   // RLS and its excitation.
   std::optional<StatorRls> rls_;
+  // What the RLS identified, smoothed for the record (estimate_) and, slower, for the observer:
+  // the inductances, Rs and the flux offsets psi = L' i + psi_off (model_).
+  struct RlsModel {
+    double rs_ohm, ld_H, lq_H, psi_off_g_Wb = 0, psi_off_d_Wb = 0;
+  };
+  void take_rls_fit(const StatorEstimate& e, double w);
   std::optional<StatorEstimate> estimate_;
+  std::optional<RlsModel> model_;
   Prbs5 prbs_g_{0b10011}, prbs_d_{0b01101};
   double inj_g_ = 0, inj_d_ = 0;
   int rls_every_ = 10, rls_count_ = 0;

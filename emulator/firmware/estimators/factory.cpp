@@ -68,7 +68,9 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   p.rls_p0 = e.rls_p0;
   p.rls_sample_s = e.rls_sample_s;
   p.rls_estimate_filter_s = e.rls_estimate_filter_s;
+  p.rls_model_filter_s = e.rls_model_filter_s;
   p.rls_warmup_s = e.rls_warmup_s;
+  p.rls_flux_offset = e.rls_flux_offset;
   p.prbs_voltage_V = e.prbs_voltage_V;
   p.prbs_bit_s = e.prbs_bit_s;
   const double w_min = e.min_speed_rpm * kRadSPerRpm * config.synrm.pole_pairs;

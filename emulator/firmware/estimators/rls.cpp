@@ -35,7 +35,9 @@ std::optional<StatorEstimate> StatorRls::estimate() const {
   const Eigen::Matrix2d ls = 0.5 * (l + l.transpose());
   const double half_diff = 0.5 * (ls(0, 0) - ls(1, 1));
   const double disc = std::sqrt(half_diff * half_diff + ls(0, 1) * ls(0, 1));
-  StatorEstimate e{-0.5 * (binv * a).trace(), 0.5 * ls.trace() + disc, 0.5 * ls.trace() - disc};
+  const Eigen::Vector2d offset = -binv * Eigen::Vector2d(theta_(4, 0), theta_(4, 1));
+  StatorEstimate e{-0.5 * (binv * a).trace(), 0.5 * ls.trace() + disc, 0.5 * ls.trace() - disc,
+                   offset(0), offset(1)};
   if (!(e.lq_H > 0) || !std::isfinite(e.rs_ohm)) return std::nullopt;
   return e;
 }

@@ -21,6 +21,9 @@ namespace synbench::emulator::firmware {
 
 struct StatorEstimate {
   double rs_ohm = 0, ld_H = 0, lq_H = 0;
+  // The affine part as a voltage, -B^-1 c = w J psi_off: the back-EMF of the flux offsets of a
+  // saturated machine linearised at the operating point (psi = L' i + psi_off).
+  double offset_g_V = 0, offset_d_V = 0;
 };
 
 class StatorRls {
