@@ -46,7 +46,8 @@ void Eemf::inductances(double ig, double id, double& ld_dyn, double& lq_static) 
     case EemfModel::rls:
       ld_dyn = model_ ? model_->ld_H : p_.ld_H;
       lq_static = model_ ? model_->lq_H : p_.lq_H;
-      // psi_q = L'q i_q + psi_off_q, faded out toward zero q current where it means nothing.
+      // psi_q = L'q i_q + psi_off_q, faded out below about 0.1 A of q current, where the
+      // offset over the current means nothing.
       if (model_) lq_static += model_->psi_off_d_Wb * id / (id * id + 0.01);
       return;
   }
@@ -193,7 +194,8 @@ void Eemf::take_rls_fit(const StatorEstimate& e, double w) {
   toward(model_->rs_ohm, e.rs_ohm, tau);
   toward(model_->ld_H, e.ld_H, tau);
   toward(model_->lq_H, e.lq_H, tau);
-  // The offset EMF is w J psi_off in the frame the RLS identified in, at the speed it turned at.
+  // The offset EMF is w J psi_off in the frame the RLS identified in, at the speed it turned at
+  // (below 20 rad/s the division amplifies the fit's noise; the EEMF hands over long before).
   if (p_.rls_flux_offset && std::fabs(w) > 20.0) {
     toward(model_->psi_off_g_Wb, e.offset_d_V / w, tau);
     toward(model_->psi_off_d_Wb, -e.offset_g_V / w, tau);

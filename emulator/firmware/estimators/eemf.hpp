@@ -8,7 +8,8 @@
 // (active_flux_speed.hpp) [ours].
 // Three sources of Rs, L'd, Lq as in the thesis: constant (Ld = 0.65 H, Lq = 0.2 H), the
 // flux-map tables (optionally deformed, thesis 4.1 and 4.2), or RLS identification excited by
-// PRBS voltage injection on both axes.
+// PRBS voltage injection on both axes (for the observer over a slow model, completed by the RLS's
+// flux offsets into the static flux [ours]; docs/estimators.md).
 #pragma once
 
 #include <optional>
@@ -114,7 +115,8 @@ class Eemf final : public Estimator {
   // RLS and its excitation.
   std::optional<StatorRls> rls_;
   // What the RLS identified, smoothed for the record (estimate_) and, slower, for the observer:
-  // the inductances, Rs and the flux offsets psi = L' i + psi_off (model_).
+  // the inductances, Rs and the flux offsets psi = L' i + psi_off (model_), on the estimated
+  // frame's gamma (d) and delta (q) axes as everywhere here.
   struct RlsModel {
     double rs_ohm, ld_H, lq_H, psi_off_g_Wb = 0, psi_off_d_Wb = 0;
   };
