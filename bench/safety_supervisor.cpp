@@ -51,7 +51,7 @@ void SafetySupervisor::estop(double now_s, const std::string& why) {
   stop_duration_s_ = 0.0;
 }
 
-std::error_code SafetySupervisor::reset(double /*now_s*/) {
+std::error_code SafetySupervisor::reset() {
   if (stop_.active()) return make_error_code(errc::busy);
   if (auto ec = dev_.synrm->reset_fault()) return ec;
   if (auto ec = dev_.load->reset_fault()) return ec;

@@ -51,7 +51,7 @@ class SafetySupervisor {
   void estop(double now_s, const std::string& why = "E-stop");
   // Explicit reset: clears the latch and the devices' latched faults. Refused while an ordered
   // stop is still running. Never restarts anything.
-  std::error_code reset(double now_s);
+  std::error_code reset();
 
   bool tripped() const { return trip_.has_value(); }
   bool may_command() const { return !trip_; }

@@ -228,7 +228,7 @@ void BenchRuntime::estop() {
 
 std::optional<Refusal> BenchRuntime::reset() {
   std::lock_guard lock(mutex_);
-  if (auto ec = supervisor_->reset(backend_->clock().now_s()))
+  if (auto ec = supervisor_->reset())
     return Refusal{409, "stop_in_progress", "reset refused: " + ec.message()};
   return std::nullopt;
 }

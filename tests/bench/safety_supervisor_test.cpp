@@ -96,7 +96,7 @@ double check_class(const Op& op, const Inject& inject, drivers::Fault expected,
   h.bench.twin().faults() = emulator::PlantFaults{};
   if (expected == drivers::Fault::overtemperature) h.bench.twin().set_winding_temp_C(50);
   h.run_until(h.t + 1.0);
-  EXPECT_FALSE(h.sup.reset(h.t)) << at;
+  EXPECT_FALSE(h.sup.reset()) << at;
   h.run_until(h.t + 1.0);
   EXPECT_FALSE(h.sup.tripped()) << at;
   EXPECT_TRUE(h.drives_off()) << at;

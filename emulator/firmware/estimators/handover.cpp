@@ -4,6 +4,16 @@
 #include <cmath>
 
 namespace synbench::emulator::firmware {
+namespace {
+
+EstimatorOutput encoder_output(const EstimatorInput& in) {
+  EstimatorOutput o;
+  o.theta_e_rad = in.encoder_theta_e_rad;
+  o.omega_e_rad_s = in.encoder_omega_e_rad_s;
+  return o;
+}
+
+}  // namespace
 
 LowSpeedHandover::LowSpeedHandover(std::unique_ptr<Estimator> main,
                                    std::unique_ptr<Estimator> fallback, double min_speed_rad_s,
@@ -26,7 +36,15 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
       // its minimum speed, whose estimate falls while the shaft holds: handed to the encoder
       // unseen, such a point kept a position error sweeping the whole half turn, unflagged.
       if (!fallback_ && std::fabs(in.encoder_omega_e_rad_s) > min_ - hyst_) slipped_ = true;
-      if (fallback_) fallback_->align(o.theta_e_rad, o.omega_e_rad_s);
+      // The source from this very period on: what the fallback gave when it last ran is stale
+      // by however long the observer held (one period's angle tens of degrees off, which the
+      // window's position error counted as a slip).
+      if (fallback_) {
+        fallback_->align(o.theta_e_rad, o.omega_e_rad_s);
+        fallback_out_ = fallback_->output();
+      } else {
+        fallback_out_ = encoder_output(in);
+      }
     }
     return;
   }
@@ -34,8 +52,7 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
     fallback_->update(in);
     fallback_out_ = fallback_->output();
   } else {
-    fallback_out_.theta_e_rad = in.encoder_theta_e_rad;
-    fallback_out_.omega_e_rad_s = in.encoder_omega_e_rad_s;
+    fallback_out_ = encoder_output(in);
   }
   main_->update(in);
   main_->align(fallback_out_.theta_e_rad, fallback_out_.omega_e_rad_s);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <optional>
 
 namespace synbench::emulator::firmware {
 namespace {
@@ -39,13 +40,22 @@ struct Fixture {
     h = std::make_unique<LowSpeedHandover>(std::move(m), nullptr, kMin, kHyst, kTs);
   }
   // 0.1 s with the shaft at `shaft` and the EEMF's estimate at `estimate` (once it is the source).
+  // The encoder's angle advances at the shaft's speed; the hand-back's period is recorded.
   void run(double shaft, double estimate) {
     in.encoder_omega_e_rad_s = shaft;
     for (int k = 0; k < 1000; ++k) {
       if (h->main_active()) main->omega = estimate;
+      in.encoder_theta_e_rad = wrap_pi(in.encoder_theta_e_rad + shaft * kTs);
+      const bool was_active = h->main_active();
       h->update(in);
+      if (was_active && !h->main_active()) handed_back = {in.encoder_theta_e_rad, h->output()};
     }
   }
+  struct HandBack {
+    double encoder_theta_rad;
+    EstimatorOutput out;
+  };
+  std::optional<HandBack> handed_back;
 };
 
 TEST(LowSpeedHandover, TakesOverAboveTheMinimumLessTheHysteresis) {
@@ -75,6 +85,20 @@ TEST(LowSpeedHandover, AnEstimateFallingAwayFromTheShaftSlipped) {
   // Handed back, and taken over again aligned to the encoder at once (the shaft is above the
   // take-over speed): without the flag nothing would show but a jump of the angle.
   EXPECT_TRUE(f.h->slipped());
+}
+
+TEST(LowSpeedHandover, TheHandBackPeriodAlreadyGivesTheEncodersAngle) {
+  // It gave, for that one period, the angle the encoder had when the observer took over (about
+  // 0.13 s and 13 rad earlier here): on the thesis grid's 500 rpm points one period tens of
+  // degrees off, which the window's position error counted as the observer out of lock.
+  Fixture f;
+  f.run(90.0, 90.0);
+  f.run(100.0, 100.0);
+  ASSERT_FALSE(f.h->on_fallback());
+  f.run(88.0, 88.0);
+  ASSERT_TRUE(f.handed_back);
+  EXPECT_DOUBLE_EQ(f.handed_back->out.theta_e_rad, f.handed_back->encoder_theta_rad);
+  EXPECT_DOUBLE_EQ(f.handed_back->out.omega_e_rad_s, 88.0);
 }
 
 }  // namespace
