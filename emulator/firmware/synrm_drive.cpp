@@ -382,12 +382,16 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     const bool lost = estimator_->lock_lost();
     window_fallback_ += estimator_->on_fallback() ? 1 : 0;
     window_lock_lost_ += lost ? 1 : 0;
-    // The estimator's fields from the samples it drove: on the lock guard the angle is the
-    // encoder's (an error of exactly 0) and the estimates are the lost estimator's last ones.
-    // A window wholly on the guard leaves them empty (null in the record).
-    if (!lost) {
+    // The estimator's fields from the samples it drove: on the lock guard and on an EEMF's
+    // encoder fallback the angle is the encoder's (an error of exactly 0, which pulled the mean
+    // of a point handed back for a third of its window a third toward zero), and on the guard
+    // the estimates are the lost estimator's last ones (on the fallback the RLS goes on
+    // identifying). A window wholly on them leaves the fields empty (null in the record).
+    if (!estimator_->encoder_angle()) {
       w_pos_err_.add(wrap_half_turn_deg(pos_err_rad));
       w_speed_err_.add(speed_err_rpm);
+    }
+    if (!lost) {
       const EstimatorOutput o = estimator_->output();
       if (o.ld_H) w_ld_.add(*o.ld_H);
       if (o.lq_H) w_lq_.add(*o.lq_H);

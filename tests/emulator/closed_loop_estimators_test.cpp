@@ -442,6 +442,19 @@ void lose_the_rotor_at_76_deg(emulator::Twin& tw, drivers::Estimator e, double s
   run_s(tw, 0.5);
 }
 
+TEST(ClosedLoopEstimators, AnEemfPointWhollyOnItsEncoderFallbackHasNoPositionError) {
+  // 300 rpm is below the EEMF's 500 rpm minimum: the encoder gives the angle all window long.
+  // Its exact zeros are no measurement of the estimator (they pulled the means of points handed
+  // back for part of their window toward zero); the RLS goes on identifying meanwhile.
+  const auto r = measure_with(drivers::Estimator::eemf_rls, 300, 1.0, 50);
+  EXPECT_FALSE(r.fault);
+  EXPECT_EQ(r.fallback_fraction, 1.0);
+  EXPECT_TRUE(r.below_min_speed);
+  EXPECT_FALSE(r.pos_err_mean_deg || r.pos_err_min_deg || r.pos_err_max_deg || r.speed_err_rpm);
+  ASSERT_TRUE(r.ld_est_H && r.lq_est_H && r.rs_est_ohm) << "the RLS's estimates are kept";
+  EXPECT_GT(*r.ld_est_H, *r.lq_est_H) << "identified on the encoder's frame";
+}
+
 TEST(ClosedLoopEstimators, TheLockGuardHandsBackOnceTheNewSetpointsAreReached) {
   // The thesis' direction-only observer, which loses EEMF-LUT's rotor at 76 deg.
   emulator::TwinConfig cfg;

@@ -68,8 +68,12 @@ class Estimator {
   virtual bool on_fallback() const { return false; }
   // True once the estimator's own speed has been seen falling away from the shaft's (a low-speed
   // handover gave the angle back to the encoder while the shaft still turned above the take-over
-  // speed): the drive's lock guard counts it as a lost rotor.
+  // speed and the estimator's angle had left the shaft's): the drive's lock guard counts it as a
+  // lost rotor.
   virtual bool slipped() const { return false; }
+  // True while this period's angle is the encoder's (a low-speed handover to the encoder, the
+  // lock guard): a position or speed error against the encoder then measures nothing.
+  virtual bool encoder_angle() const { return false; }
   // Takes over the given angle and speed (a handover from another position source).
   virtual void align(double /*theta_e_rad*/, double /*omega_e_rad_s*/) {}
   // True while the drive's lock guard has taken the angle from the encoder (LockGuard); rearm()

@@ -77,7 +77,7 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   const double w_hyst = e.handover_hysteresis_rpm * kRadSPerRpm * config.synrm.pole_pairs;
   return std::make_unique<LowSpeedHandover>(
       std::make_unique<Eemf>(p), e.low_speed_source == "hfi" ? make_hfi(config) : nullptr, w_min,
-      w_hyst, p.ts_s);
+      w_hyst, config.firmware.lock_guard_deg * kPi / 180.0, p.ts_s);
 }
 
 EstimatorChoice make_sensorless(drivers::Estimator kind, const TwinConfig& config) {

@@ -17,10 +17,10 @@ EstimatorOutput encoder_output(const EstimatorInput& in) {
 
 LowSpeedHandover::LowSpeedHandover(std::unique_ptr<Estimator> main,
                                    std::unique_ptr<Estimator> fallback, double min_speed_rad_s,
-                                   double hysteresis_rad_s, double ts_s,
+                                   double hysteresis_rad_s, double slip_angle_rad, double ts_s,
                                    double speed_filter_s)
     : main_(std::move(main)), fallback_(std::move(fallback)), min_(min_speed_rad_s),
-      hyst_(hysteresis_rad_s) {
+      hyst_(hysteresis_rad_s), slip_angle_(slip_angle_rad) {
   main_speed_.configure(speed_filter_s, ts_s);
   fallback_speed_.configure(speed_filter_s, ts_s);
 }
@@ -32,10 +32,15 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
     fallback_speed_.reset(main_speed_.update(o.omega_e_rad_s));
     if (std::fabs(main_speed_.value()) < min_ - 2.0 * hyst_) {
       main_active_ = false;
-      // The encoder as the fallback tells a genuinely slower shaft from an observer slipping at
-      // its minimum speed, whose estimate falls while the shaft holds: handed to the encoder
-      // unseen, such a point kept a position error sweeping the whole half turn, unflagged.
-      if (!fallback_ && std::fabs(in.encoder_omega_e_rad_s) > min_ - hyst_) slipped_ = true;
+      // The encoder as the fallback tells an observer slipping at its minimum speed (its
+      // estimate falls while the shaft holds, and its angle has left the shaft's) from a
+      // genuinely slower shaft and from a dip of the speed estimate alone: at 500 rpm the
+      // EEMF-RLS observer's 20 ms speed dipped under the hand-back speed with the shaft at 477
+      // to 502 rpm and its angle 6 to 12 deg off, within its in-lock spread; counted as slips,
+      // they lost 24 of the thesis grid's 133 points at that speed (2026-12-03).
+      if (!fallback_ && std::fabs(in.encoder_omega_e_rad_s) > min_ - hyst_ &&
+          std::fabs(half_turn_error_rad(o.theta_e_rad - in.encoder_theta_e_rad)) > slip_angle_)
+        slipped_ = true;
       // The source from this very period on: what the fallback gave when it last ran is stale
       // by however long the observer held (one period's angle tens of degrees off, which the
       // window's position error counted as a slip).

@@ -40,6 +40,7 @@ class LockGuard final : public Estimator {
     inner_->align(theta_e_rad, omega_e_rad_s);
   }
   bool lock_lost() const override { return tripped_; }
+  bool encoder_angle() const override { return tripped_ || inner_->encoder_angle(); }
   void rearm() override;
 
  private:

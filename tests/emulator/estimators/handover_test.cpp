@@ -1,7 +1,7 @@
 // The low-speed handover (emulator/firmware/estimators/handover.hpp) around a scripted EEMF: it
 // takes over above the minimum speed less the hysteresis, hands back below two hysteresis
-// widths, and with the encoder as the fallback tells a slower shaft from an estimate that fell
-// away from the shaft's speed (slipped).
+// widths, and with the encoder as the fallback tells a slower shaft, and a dip of the speed
+// estimate alone, from an estimate that fell away from the shaft's speed and angle (slipped).
 #include "emulator/firmware/estimators/handover.hpp"
 
 #include <gtest/gtest.h>
@@ -15,17 +15,21 @@ namespace {
 constexpr double kTs = 1e-4;
 constexpr double kMin = 100.0, kHyst = 5.0;  // rad/s, electrical
 
-// Reports a scripted speed; remembers the alignments it is given.
+constexpr double kSlipAngle = 0.785;  // rad
+
+// Reports a scripted angle and speed; remembers the alignments it is given.
 struct Scripted final : Estimator {
-  double omega = 0, aligned_omega = 0;
+  double theta = 0, omega = 0, aligned_omega = 0;
   void update(const EstimatorInput&) override {}
   EstimatorOutput output() const override {
     EstimatorOutput o;
+    o.theta_e_rad = theta;
     o.omega_e_rad_s = omega;
     return o;
   }
-  void align(double, double omega_e_rad_s) override {
+  void align(double theta_e_rad, double omega_e_rad_s) override {
     aligned_omega = omega_e_rad_s;
+    theta = theta_e_rad;
     omega = omega_e_rad_s;
   }
 };
@@ -37,15 +41,19 @@ struct Fixture {
   Fixture() {
     auto m = std::make_unique<Scripted>();
     main = m.get();
-    h = std::make_unique<LowSpeedHandover>(std::move(m), nullptr, kMin, kHyst, kTs);
+    h = std::make_unique<LowSpeedHandover>(std::move(m), nullptr, kMin, kHyst, kSlipAngle, kTs);
   }
-  // 0.1 s with the shaft at `shaft` and the EEMF's estimate at `estimate` (once it is the source).
-  // The encoder's angle advances at the shaft's speed; the hand-back's period is recorded.
-  void run(double shaft, double estimate) {
+  // 0.1 s with the shaft at `shaft` and the EEMF's estimate at `estimate`, its angle `off_rad`
+  // from the encoder's (once it is the source). The encoder's angle advances at the shaft's
+  // speed; the hand-back's period is recorded.
+  void run(double shaft, double estimate, double off_rad = 0.0) {
     in.encoder_omega_e_rad_s = shaft;
     for (int k = 0; k < 1000; ++k) {
-      if (h->main_active()) main->omega = estimate;
       in.encoder_theta_e_rad = wrap_pi(in.encoder_theta_e_rad + shaft * kTs);
+      if (h->main_active()) {
+        main->omega = estimate;
+        main->theta = wrap_pi(in.encoder_theta_e_rad + off_rad);
+      }
       const bool was_active = h->main_active();
       h->update(in);
       if (was_active && !h->main_active()) handed_back = {in.encoder_theta_e_rad, h->output()};
@@ -81,10 +89,24 @@ TEST(LowSpeedHandover, AnEstimateFallingAwayFromTheShaftSlipped) {
   Fixture f;
   f.run(100.0, 100.0);
   ASSERT_FALSE(f.h->on_fallback());
-  f.run(100.0, 85.0);  // the shaft holds; the estimate falls below min - 2 hyst
+  f.run(100.0, 85.0, 1.0);  // the shaft holds; the estimate falls below min - 2 hyst, 57 deg off
   // Handed back, and taken over again aligned to the encoder at once (the shaft is above the
   // take-over speed): without the flag nothing would show but a jump of the angle.
+  EXPECT_TRUE(f.handed_back);
   EXPECT_TRUE(f.h->slipped());
+}
+
+TEST(LowSpeedHandover, ASpeedEstimateDippingWithTheAngleHeldIsNoSlip) {
+  // At 500 rpm the EEMF-RLS observer's speed dips under the hand-back speed while its angle stays
+  // within its in-lock spread (6 to 12 deg); a hand-back then, not a lost rotor.
+  Fixture f;
+  f.run(100.0, 100.0);
+  ASSERT_FALSE(f.h->on_fallback());
+  f.run(100.0, 85.0, -0.2);
+  EXPECT_TRUE(f.handed_back);
+  EXPECT_FALSE(f.h->slipped());
+  f.run(100.0, 100.0);
+  EXPECT_FALSE(f.h->on_fallback()) << "taken over again: the shaft is above the take-over speed";
 }
 
 TEST(LowSpeedHandover, TheHandBackPeriodAlreadyGivesTheEncodersAngle) {
