@@ -5,6 +5,7 @@
 #include <numbers>
 #include <utility>
 
+#include "emulator/firmware/estimators/ekf_correct.hpp"
 #include "emulator/mcidc.hpp"
 
 namespace synbench::emulator::firmware {
@@ -84,11 +85,8 @@ void EkfBasic::update(const EstimatorInput& in) {
     MeasRow hm;
     hm << c2, s2, 0.0, 2.0 * (x_(kRq) - x_(kRd)) * s * c;
     const State pht = p_ * hm.transpose();
-    const double sv = hm.dot(pht) + r_;
-    const State k = pht / sv;
-    x_ += k * innovation;
-    p_.noalias() -= k * pht.transpose();
-    p_ = (0.5 * (p_ + p_.transpose())).eval();
+    ekf_correct(x_, p_, pht, Eigen::Matrix<double, 1, 1>{hm.dot(pht) + r_},
+                Eigen::Matrix<double, 1, 1>{innovation});
   }
 
   x_(kRd) = std::max(x_(kRd), params_.min_reluctance_per_H);

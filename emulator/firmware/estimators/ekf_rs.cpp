@@ -6,8 +6,7 @@
 #include <numbers>
 #include <utility>
 
-#include <Eigen/LU>
-
+#include "emulator/firmware/estimators/ekf_correct.hpp"
 #include "emulator/mcidc.hpp"
 
 namespace synbench::emulator::firmware {
@@ -194,11 +193,7 @@ void EkfRs::correct(const Eigen::Matrix<double, M, 1>& innovation,
   }
   Eigen::Matrix<double, M, M> sm = hm * pht;
   sm.diagonal() += r_diag;
-  const Eigen::Matrix<double, kN, M> k = pht * sm.inverse();  // closed-form 2x2 or 3x3
-  x_.noalias() += k * innovation;
-  // P - K S K^T = P - K (P H^T)^T, then symmetrized against round-off.
-  p_.noalias() -= k * pht.transpose();
-  p_ = (0.5 * (p_ + p_.transpose())).eval();
+  ekf_correct(x_, p_, pht, sm, innovation);
 }
 
 void EkfRs::update(const EstimatorInput& in) {
