@@ -43,7 +43,7 @@ void LowSpeedHandover::update(const EstimatorInput& in) {
         slipped_ = true;
       // The source from this very period on: what the fallback gave when it last ran is stale
       // by however long the observer held (one period's angle tens of degrees off, which the
-      // window's position error counted as a slip).
+      // window's position error counted as the observer out of lock).
       if (fallback_) {
         fallback_->align(o.theta_e_rad, o.omega_e_rad_s);
         fallback_out_ = fallback_->output();
