@@ -7,7 +7,8 @@
 // lock guard ran on the encoder, points out of lock (position-error span over 90 deg: a slipping
 // observer sweeps the whole (-90, 90] deg), the worst |mean position error| in lock, the mean
 // settling time, the points an EEMF's low-speed fallback gave the angle for part of the window
-// and the largest such part, the restarts, the sweep's end state and the wall time. Exits 1 when the sweep does not complete.
+// and the largest such part, the restarts, the sweep's end state and the wall time. Exits 1
+// when the sweep does not complete.
 // usage: estimator_chain --estimator NAME [--pwm capwm|aspwm] [--speeds a,b,..] [--loads ..]
 //                        [--angles ..] [--timeout-s S] [--config FILE] [--verbose]
 //   defaults: the thesis-grid preset (EEMF variants from 500 rpm, HFI up to 300 rpm), the thesis
@@ -164,18 +165,19 @@ int main(int argc, char** argv) {
       if (!lost) x->worst_in_lock_deg = std::max(x->worst_in_lock_deg, std::fabs(*r.pos_err_mean_deg));
     }
     if (verbose)
-      std::printf("%g rpm %g N m %g deg: pos %+.2f [%+.1f, %+.1f] deg, speed %.1f rpm, settle %.1f s, "
-                  "fallback %.1f %%%s\n",
+      std::printf("%g rpm %g N m %g deg: pos %+.2f [%+.1f, %+.1f] deg, speed %.1f rpm, "
+                  "settle %.1f s, fallback %.1f %%%s\n",
                   r.speed_rpm, r.load_Nm, r.angle_deg, r.pos_err_mean_deg.value_or(NAN),
-                  r.pos_err_min_deg.value_or(NAN), r.pos_err_max_deg.value_or(NAN), r.speed_meas_rpm,
-                  r.settle_s, 100.0 * r.fallback_fraction,
+                  r.pos_err_min_deg.value_or(NAN), r.pos_err_max_deg.value_or(NAN),
+                  r.speed_meas_rpm, r.settle_s, 100.0 * r.fallback_fraction,
                   r.unstable ? " UNSTABLE" : r.lock_lost ? " LOCK LOST" : "");
   }
   auto print = [](const char* what, const Tally& t) {
     std::printf("%-8s %4d points, %3d unstable, %3d lock lost, %3d out of lock, worst |mean| in "
                 "lock %5.2f deg, mean settle %.1f s, %3d on the fallback (at most %.1f %%)\n",
                 what, t.points, t.unstable, t.lock_lost, t.out_of_lock, t.worst_in_lock_deg,
-                t.points ? t.settle_sum_s / t.points : 0.0, t.on_fallback, 100.0 * t.max_fallback);
+                t.points ? t.settle_sum_s / t.points : 0.0, t.on_fallback,
+                100.0 * t.max_fallback);
   };
   std::printf("%s / %s, as a sweep\n", std::string(synbench::drivers::name(e)).c_str(),
               std::string(synbench::drivers::name(*pwm)).c_str());
