@@ -1,6 +1,7 @@
 // Limits, latched trips, ordered stop and E-stop.
 #include "bench/safety_supervisor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -16,6 +17,17 @@ std::string format(const char* fmt, double a, double b) {
 }
 
 }  // namespace
+
+SafetyLimits stricter(const SafetyLimits& a, const SafetyLimits& b) {
+  SafetyLimits l = a;
+  l.max_speed_rpm = std::min(a.max_speed_rpm, b.max_speed_rpm);
+  l.max_current_A = std::min(a.max_current_A, b.max_current_A);
+  l.max_udc_V = std::min(a.max_udc_V, b.max_udc_V);
+  l.min_udc_V = std::max(a.min_udc_V, b.min_udc_V);
+  l.max_temp_C = std::min(a.max_temp_C, b.max_temp_C);
+  l.link_timeout_s = std::min(a.link_timeout_s, b.link_timeout_s);
+  return l;
+}
 
 SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits,
                                    EventSink sink)
@@ -36,8 +48,11 @@ void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string det
 }
 
 void SafetySupervisor::disable_all() {
-  dev_.synrm->enable(false);
-  dev_.load->enable(false);
+  // Both are always tried: a failed SynRM disable must not keep the load's from being sent.
+  const std::error_code ec_s = dev_.synrm->enable(false);
+  const std::error_code ec_l = dev_.load->enable(false);
+  if (sink_ && ec_s) sink_("fault", "disabling the SynRM drive failed: " + ec_s.message());
+  if (sink_ && ec_l) sink_("fault", "disabling the load drive failed: " + ec_l.message());
 }
 
 void SafetySupervisor::estop(double now_s, const std::string& why) {
@@ -49,14 +64,53 @@ void SafetySupervisor::estop(double now_s, const std::string& why) {
   }
   phase_ = SafetyPhase::estopped;
   stop_duration_s_ = 0.0;
+  expect_stopped(now_s);
+}
+
+void SafetySupervisor::expect_stopped(double now_s) {
+  if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
+}
+
+std::string SafetySupervisor::still_running() const {
+  std::string s;
+  const auto add = [&s](const char* what) { s += (s.empty() ? "" : " and ") + std::string(what); };
+  if (!synrm_) add("the SynRM drive cannot be read");
+  else if (drivers::running(synrm_->state)) add("the SynRM drive still reports running");
+  if (!load_) add("the load drive cannot be read");
+  else if (drivers::running(load_->state)) add("the load drive still reports running");
+  return s;
+}
+
+void SafetySupervisor::confirm_stop(double now_s) {
+  if (!confirm_deadline_s_) return;
+  const std::string running = still_running();
+  if (running.empty()) {
+    confirm_deadline_s_.reset();
+    return;
+  }
+  // A disable lost on the link, or a drive that ignored it: say it again every tick.
+  if (synrm_ && drivers::running(synrm_->state)) dev_.synrm->enable(false);
+  if (load_ && drivers::running(load_->state)) dev_.load->enable(false);
+  if (alarm_ || now_s < *confirm_deadline_s_) return;
+  char when[48];
+  std::snprintf(when, sizeof when, " %.2f s after the disable", now_s - (*confirm_deadline_s_ - lim_.stop_confirm_s));
+  alarm_ = SafetyAlarm{running + when, now_s};
+  if (sink_) sink_("alarm", "ALARM: " + alarm_->detail + "; their own watchdogs are the second line");
 }
 
 std::error_code SafetySupervisor::reset() {
   if (stop_.active()) return make_error_code(errc::busy);
+  if (alarm_ || confirm_deadline_s_) {
+    // A reset must never hide a drive that did not stop.
+    if (!still_running().empty()) return make_error_code(errc::busy);
+  }
   if (auto ec = dev_.synrm->reset_fault()) return ec;
   if (auto ec = dev_.load->reset_fault()) return ec;
   if (trip_ && sink_) sink_("state", "reset after " + std::string(drivers::fault_name(trip_->fault)));
+  if (alarm_ && sink_) sink_("state", "alarm cleared: both drives read back stopped");
   trip_.reset();
+  alarm_.reset();
+  confirm_deadline_s_.reset();
   stop_duration_s_.reset();
   phase_ = SafetyPhase::normal;
   return {};
@@ -102,6 +156,7 @@ void SafetySupervisor::tick(double now_s) {
     raise(now_s, drivers::Fault::load_drive, "load drive reports " + std::string(drivers::fault_name(load_->fault)));
 
   advance_stop(now_s);
+  confirm_stop(now_s);
 }
 
 void SafetySupervisor::advance_stop(double now_s) {
@@ -112,6 +167,7 @@ void SafetySupervisor::advance_stop(double now_s) {
   }
   phase_ = SafetyPhase::stopped;
   stop_duration_s_ = now_s - trip_->at_s;
+  expect_stopped(now_s);
   if (sink_) sink_("state", "ordered stop complete after " + std::to_string(*stop_duration_s_) + " s");
 }
 

@@ -1,7 +1,10 @@
 // Safety supervisor of the bench: checked every tick, whatever a sweep is doing. On a limit
 // violation, a device fault or a lost link it brings the bench to the ordered stop — load torque
 // to zero, then speed to zero, then both drives disabled — and latches the reason until an
-// explicit reset; an E-stop disables both drives at once. Pure logic on the time it is given.
+// explicit reset; an E-stop disables both drives at once. Every disable's result is checked and
+// the drives' state is read back: a drive that still reports running (or cannot be read) after
+// `stop_confirm_s` latches a loud alarm, and its disable is repeated every tick until it stops.
+// Pure logic on the time it is given.
 #pragma once
 
 #include <functional>
@@ -24,7 +27,12 @@ struct SafetyLimits {
   double stop_load_timeout_s = 1.0;   // step one of the ordered stop; then the load is disabled
   double stop_speed_timeout_s = 10.0; // step two, then disable regardless
   double stopped_speed_rpm = 20.0;
+  // After a stop's disable, the drives must read back as not running within this long.
+  double stop_confirm_s = 0.3;
 };
+
+// The stricter of two sets of limits, each bound on its own (a plan may tighten the bench's).
+SafetyLimits stricter(const SafetyLimits& a, const SafetyLimits& b);
 
 // Why the bench stopped; `fault` names it with the device fault vocabulary.
 struct SafetyTrip {
@@ -34,6 +42,13 @@ struct SafetyTrip {
 };
 
 enum class SafetyPhase { normal, stopping_load, stopping_speed, stopped, estopped };
+
+// A stop that did not take: a drive still reports running after its disable, or its state cannot
+// be read back. Latched until a reset finds the drives stopped.
+struct SafetyAlarm {
+  std::string detail;  // "SynRM drive still reports running 0.30 s after its disable"
+  double at_s = 0;
+};
 
 class SafetySupervisor {
  public:
@@ -49,14 +64,23 @@ class SafetySupervisor {
 
   // Immediate disable of both drives; latched like any trip.
   void estop(double now_s, const std::string& why = "E-stop");
+  // Someone else's ordered stop (a user's disable, a sweep's end) has just disabled the drives:
+  // confirm it by reading them back, as after a trip.
+  void expect_stopped(double now_s);
   // Explicit reset: clears the latch and the devices' latched faults. Refused while an ordered
-  // stop is still running. Never restarts anything.
+  // stop is still running, or while a drive still reads back running after a stop (errc::busy).
+  // Never restarts anything.
   std::error_code reset();
+  void set_limits(const SafetyLimits& limits) { lim_ = limits; }
+  const SafetyLimits& limits() const { return lim_; }
 
   bool tripped() const { return trip_.has_value(); }
   bool may_command() const { return !trip_; }
   SafetyPhase phase() const { return phase_; }
   const std::optional<SafetyTrip>& trip() const { return trip_; }
+  const std::optional<SafetyAlarm>& alarm() const { return alarm_; }
+  // Set while a stop's disable is being confirmed by reading the drives back.
+  bool confirming_stop() const { return confirm_deadline_s_.has_value(); }
   // Time from detection to both drives disabled, once the stop has completed.
   std::optional<double> stop_duration_s() const { return stop_duration_s_; }
 
@@ -64,6 +88,9 @@ class SafetySupervisor {
   void raise(double now_s, drivers::Fault fault, std::string detail);
   void advance_stop(double now_s);
   void disable_all();
+  void confirm_stop(double now_s);
+  // Which drives read back as running (or unreadable), in words; empty when both are off.
+  std::string still_running() const;
 
   drivers::BenchDevices dev_;
   SafetyLimits lim_;
@@ -75,6 +102,8 @@ class SafetySupervisor {
   SafetyPhase phase_ = SafetyPhase::normal;
   OrderedStop stop_;
   std::optional<SafetyTrip> trip_;
+  std::optional<SafetyAlarm> alarm_;
+  std::optional<double> confirm_deadline_s_;
   std::optional<double> stop_duration_s_;
 };
 

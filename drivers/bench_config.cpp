@@ -162,11 +162,34 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
   Parser p;
   BenchConfig c;
   if (!p.object(doc, "")) return {std::nullopt, p.errors};
-  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "links", "devices"});
+  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "links", "devices", "limits",
+                             "setpoints", "calibration"});
   if (auto v = p.number(doc, "", "time_scale", 0.001, 1000)) c.time_scale = *v;
   if (auto v = p.number(doc, "", "poll_period_ms", 1, 10000)) c.poll_period_ms = *v;
   if (auto v = p.number(doc, "", "window_margin_s", 0, 3600)) c.window_margin_s = *v;
   if (auto v = p.number(doc, "", "retries", 0, 5, true)) c.retries = static_cast<int>(*v);
+
+  if (const auto l = doc.find("limits"); l != doc.end() && p.object(*l, "/limits")) {
+    p.reject_unknown(*l, "/limits", {"max_speed_rpm", "max_current_A", "max_udc_V", "min_udc_V", "max_temp_C",
+                                     "link_timeout_ms"});
+    c.limits.max_speed_rpm = p.number(*l, "/limits", "max_speed_rpm", 1, 100000);
+    c.limits.max_current_A = p.number(*l, "/limits", "max_current_A", 0.01, 10000);
+    c.limits.max_udc_V = p.number(*l, "/limits", "max_udc_V", 1, 10000);
+    c.limits.min_udc_V = p.number(*l, "/limits", "min_udc_V", 0, 10000);
+    c.limits.max_temp_C = p.number(*l, "/limits", "max_temp_C", -40, 400);
+    c.limits.link_timeout_ms = p.number(*l, "/limits", "link_timeout_ms", 10, 60000);
+    if (c.limits.max_udc_V && c.limits.min_udc_V && *c.limits.min_udc_V >= *c.limits.max_udc_V)
+      p.fail("/limits/min_udc_V", "must be below max_udc_V");
+  }
+  if (const auto sp = doc.find("setpoints"); sp != doc.end() && p.object(*sp, "/setpoints")) {
+    p.reject_unknown(*sp, "/setpoints", {"max_speed_rpm", "max_load_Nm"});
+    c.setpoints.max_speed_rpm = p.number(*sp, "/setpoints", "max_speed_rpm", 1, 100000);
+    c.setpoints.max_load_Nm = p.number(*sp, "/setpoints", "max_load_Nm", 0, 100000);
+  }
+  if (const auto cal = doc.find("calibration"); cal != doc.end() && p.object(*cal, "/calibration")) {
+    p.reject_unknown(*cal, "/calibration", {"load_b1_Nms_per_rad"});
+    c.calibration.load_b1_Nms_per_rad = p.number(*cal, "/calibration", "load_b1_Nms_per_rad", 0, 1);
+  }
 
   const auto links = doc.find("links");
   if (links == doc.end()) {

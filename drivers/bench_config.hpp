@@ -32,6 +32,18 @@ struct DeviceConfig {
   std::optional<std::uint8_t> unit_id;  // replaces the profile's unit id
 };
 
+// What the bench itself allows and how it is calibrated, for real drives (the twin's come from
+// its config). Each key is optional; the application fills in its defaults.
+struct BenchLimitsConfig {
+  std::optional<double> max_speed_rpm, max_current_A, max_udc_V, min_udc_V, max_temp_C, link_timeout_ms;
+};
+struct BenchSetpointsConfig {
+  std::optional<double> max_speed_rpm, max_load_Nm;
+};
+struct BenchCalibrationConfig {
+  std::optional<double> load_b1_Nms_per_rad;
+};
+
 struct BenchConfig {
   double time_scale = 1.0;      // bench seconds per wall second; match `synbench emulate --time-scale`
   double poll_period_ms = 10;   // how often the bench reads telemetry
@@ -39,6 +51,9 @@ struct BenchConfig {
   int retries = 1;              // repeats of a request after a timeout or malformed reply
   std::map<std::string, LinkConfig> links;
   DeviceConfig synrm_drive, load_drive, vfc_meter;
+  BenchLimitsConfig limits;            // the safety supervisor's trips
+  BenchSetpointsConfig setpoints;      // what an operator may command
+  BenchCalibrationConfig calibration;
 
   const DeviceConfig& device(DeviceKind k) const;
   // Whether the devices run on the in-process twin (all of them, or none: a config that

@@ -15,10 +15,11 @@ built-in twin.
 
 commands:
   point     measure one operating point (in-process twin, or devices of a bench config)
-  sweep     run a sweep plan on the twin, stored in SQLite, resumable
+  sweep     run a sweep plan on the twin or a bench config's drives, stored in SQLite, resumable
   config    print or check the twin's configuration
   emulate   serve the twin over Modbus TCP or RTU
-  serve     run the daemon: REST API over the twin in real time (docs/api.md)
+  serve     run the daemon: REST API, WebSocket and dashboard over the twin or real drives
+  bench     read a bench config's drives, or clear their latched faults
   token     create a bearer token for the daemon
 
   synbench <command> --help    options of a command
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
   if (command == "emulate") return synbench::cli::emulate_command(args);
   if (command == "serve") return synbench::cli::serve_command(args);
   if (command == "token") return synbench::cli::token_command(args);
+  if (command == "bench") return synbench::cli::bench_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

@@ -2,6 +2,7 @@
 #include "drivers/profile_devices/profile_bench.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace synbench::drivers {
 
@@ -46,12 +47,14 @@ BenchDevices ProfileBench::devices() { return {&synrm_, &load_, &meter_, &trigge
 Clock& ProfileBench::clock() { return *clock_; }
 
 void ProfileBench::tick(double now_s) {
+  if (!heartbeats_) return;
   synrm_.tick(now_s);
   load_.tick(now_s);
   meter_.tick(now_s);
 }
 
 double ProfileBench::next_heartbeat_s() const {
+  if (!heartbeats_) return std::numeric_limits<double>::infinity();
   return std::min({synrm_.next_heartbeat_s(), load_.next_heartbeat_s(), meter_.next_heartbeat_s()});
 }
 

@@ -31,9 +31,12 @@ class ProfileBench {
   BenchDevices devices();
   // The given clock; waiting on it keeps the heartbeats going.
   Clock& clock();
-  // Sends the heartbeats due at `now_s`.
+  // Sends the heartbeats due at `now_s` (none while they are stopped).
   void tick(double now_s);
   double next_heartbeat_s() const;
+  // Stops or resumes the heartbeats: stopped, the drives' watchdogs stop the drives on their own.
+  void set_heartbeats(bool on) { heartbeats_ = on; }
+  bool heartbeats() const { return heartbeats_; }
 
   ProfileSynrmDrive& synrm() { return synrm_; }
   ProfileLoadDrive& load() { return load_; }
@@ -47,6 +50,7 @@ class ProfileBench {
   ProfileMeter meter_;
   ProfileWindowTrigger trigger_;
   std::unique_ptr<HeartbeatClock> clock_;
+  bool heartbeats_ = true;
 };
 
 }  // namespace synbench::drivers

@@ -15,14 +15,17 @@ LoadDriveFirmware::LoadDriveFirmware(const TwinConfig& config)
 }
 
 std::error_code LoadDriveFirmware::enable(bool on) {
-  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!on) {
+    // A disable from the master is obeyed at any time, also during the drive's own ordered
+    // stop (as a safe torque off would be): the gates go off and that stop's fault latches.
+    if (state_ == drivers::DriveState::stopping) trip(pending_fault_);
     torque_cmd_Nm_ = 0;
     runaway_Nm_ = 0;
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
     return {};
   }
-  if (state_ == drivers::DriveState::faulted) return make_error_code(errc::device_fault);
+  if (state_ == drivers::DriveState::stopping || state_ == drivers::DriveState::faulted)
+    return make_error_code(errc::device_fault);
   state_ = drivers::DriveState::running;
   return {};
 }

@@ -66,13 +66,16 @@ SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
 }
 
 std::error_code SynrmDriveFirmware::enable(bool on) {
-  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
   if (!on) {
+    // A disable from the master is obeyed at any time, also during the drive's own ordered
+    // stop (as a safe torque off would be): the gates go off and that stop's fault latches.
+    if (state_ == drivers::DriveState::stopping) trip(pending_fault_);
     gates_off();
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
     return {};
   }
-  if (state_ == drivers::DriveState::faulted) return make_error_code(errc::device_fault);
+  if (state_ == drivers::DriveState::stopping || state_ == drivers::DriveState::faulted)
+    return make_error_code(errc::device_fault);
   if (state_ == drivers::DriveState::running) return {};
   state_ = drivers::DriveState::running;
   // A sensorless estimator starts afresh from its initial state on every enable: while the gates

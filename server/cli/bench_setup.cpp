@@ -1,12 +1,15 @@
 // Buses, clock and profile devices from a bench config.
 #include "server/cli/bench_setup.hpp"
 
+#include <algorithm>
+
 #include "drivers/bus/modbus_bus.hpp"
 #include "drivers/real_time_clock.hpp"
 #include "emulator/modbus/twin_register_bus.hpp"
 #include "emulator/modbus/twin_service.hpp"
 #include "server/cli/args.hpp"
-#include "server/http/bench_backend.hpp"
+#include "app/bench_backend.hpp"
+#include "emulator/twin_bench.hpp"
 
 namespace synbench::cli {
 
@@ -87,28 +90,85 @@ LoadedBench load_bench_or_throw(const std::string& file, const std::string& flag
   return {std::move(*r.config), std::move(*profiles)};
 }
 
+app::BenchDescription twin_description(const emulator::TwinConfig& twin) {
+  app::BenchDescription d;
+  // The supervisor's bus limits move with the bus, as the firmware's trips do (scale_bus_to).
+  const double bus_ratio = twin.dc_bus.source_V / emulator::TwinConfig{}.dc_bus.source_V;
+  d.limits.max_udc_V *= bus_ratio;
+  d.limits.min_udc_V *= bus_ratio;
+  d.max_speed_rpm = twin.firmware.max_speed_rpm;
+  // The load drive's own current limit, as torque.
+  d.max_load_Nm = 1.5 * twin.load.pole_pairs * twin.load.psi_pm_Wb * twin.load.current_limit_A;
+  d.load_b1_Nms_per_rad = twin.load.b1_Nms_per_rad;
+  return d;
+}
+
+app::BenchDescription bench_description(const drivers::BenchConfig& config) {
+  app::BenchDescription d;
+  const auto& l = config.limits;
+  if (l.max_speed_rpm) d.limits.max_speed_rpm = *l.max_speed_rpm;
+  if (l.max_current_A) d.limits.max_current_A = *l.max_current_A;
+  if (l.max_udc_V) d.limits.max_udc_V = *l.max_udc_V;
+  if (l.min_udc_V) d.limits.min_udc_V = *l.min_udc_V;
+  if (l.max_temp_C) d.limits.max_temp_C = *l.max_temp_C;
+  if (l.link_timeout_ms) d.limits.link_timeout_s = *l.link_timeout_ms / 1000;
+  // An operator's speed stays below the supervisor's trip.
+  d.max_speed_rpm = config.setpoints.max_speed_rpm.value_or(std::min(d.max_speed_rpm, d.limits.max_speed_rpm));
+  if (config.setpoints.max_load_Nm) d.max_load_Nm = *config.setpoints.max_load_Nm;
+  if (config.calibration.load_b1_Nms_per_rad) d.load_b1_Nms_per_rad = *config.calibration.load_b1_Nms_per_rad;
+  d.poll_period_s = config.poll_period_ms / 1000;
+  return d;
+}
+
 namespace {
 
-class ConfiguredBackend final : public http::BenchBackend {
+class ConfiguredBackend final : public app::BenchBackend {
  public:
-  ConfiguredBackend(LoadedBench b, const emulator::TwinConfig& twin, double b1)
-      : bench_(b.config, std::move(b.profiles), twin), b1_(b1) {}
+  ConfiguredBackend(LoadedBench b, const emulator::TwinConfig& twin)
+      : description_(b.config.on_twin() ? twin_description(twin) : bench_description(b.config)),
+        bench_(b.config, std::move(b.profiles), twin) {
+    if (b.config.on_twin()) description_.poll_period_s = b.config.poll_period_ms / 1000;
+  }
   drivers::BenchDevices devices() override { return bench_.bench().devices(); }
   drivers::Clock& clock() override { return bench_.bench().clock(); }
   void tick(double now_s) override { bench_.bench().tick(now_s); }
+  void set_heartbeats(bool on) override { bench_.bench().set_heartbeats(on); }
+  bool heartbeats() const override { return bench_.bench().heartbeats(); }
   nlohmann::json describe() const override { return bench_.describe_devices(); }
-  double load_b1_Nms_per_rad() const override { return b1_; }
+  const app::BenchDescription& description() const override { return description_; }
+  std::string link_errors() const override { return bench_.link_errors(); }
+  std::string links() const override { return bench_.describe(); }
 
  private:
+  app::BenchDescription description_;
   ConfiguredBench bench_;
-  double b1_;
+};
+
+// The in-process twin (emulator::TwinBench), its virtual clock advanced by whoever waits on it.
+class TwinBackend final : public app::BenchBackend {
+ public:
+  explicit TwinBackend(const emulator::TwinConfig& config) : twin_(config), description_(twin_description(config)) {}
+  drivers::BenchDevices devices() override { return twin_.devices(); }
+  drivers::Clock& clock() override { return twin_.clock(); }
+  nlohmann::json describe() const override {
+    const auto dev = [](const char* role, const char* kind) {
+      return nlohmann::json{{"role", role}, {"kind", kind}, {"backend", "twin"}, {"link", "in-process"}, {"profile", nullptr}};
+    };
+    return nlohmann::json::array({dev("synrm", "synrm_drive"), dev("load", "load_drive"), dev("meter", "vfc_meter"),
+                                  dev("trigger", "window_trigger"), dev("truth", "truth_probe")});
+  }
+  const app::BenchDescription& description() const override { return description_; }
+
+ private:
+  emulator::TwinBench twin_;
+  app::BenchDescription description_;
 };
 
 }  // namespace
 
-std::unique_ptr<http::BenchBackend> make_configured_backend(LoadedBench bench, const emulator::TwinConfig& twin,
-                                                            double load_b1_Nms_per_rad) {
-  return std::make_unique<ConfiguredBackend>(std::move(bench), twin, load_b1_Nms_per_rad);
+std::unique_ptr<app::BenchBackend> make_backend(std::optional<LoadedBench> bench, const emulator::TwinConfig& twin) {
+  if (bench) return std::make_unique<ConfiguredBackend>(std::move(*bench), twin);
+  return std::make_unique<TwinBackend>(twin);
 }
 
 }  // namespace synbench::cli

@@ -1,9 +1,12 @@
-// A bench assembled from a bench config: the links (one RegisterBus per link, shared by the
-// devices on it), the clock (real time, scaled to match `synbench emulate --time-scale`, or the
-// in-process twin's virtual time) and the profile devices. What `synbench point --bench` runs.
+// The bench a command runs on, as an app::BenchBackend: the in-process twin (TwinBench), or a
+// bench config's links (one RegisterBus per link, shared by the devices on it), clock (real time,
+// scaled to match `synbench emulate --time-scale`, or the in-process twin's register map on
+// virtual time) and profile devices. `synbench serve`, `sweep`, `point` and `bench` all build
+// theirs here, so the same config means the same bench, limits and calibration everywhere.
 #pragma once
 
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <memory>
@@ -17,8 +20,9 @@ namespace synbench::emulator {
 class TwinService;
 }
 
-namespace synbench::http {
+namespace synbench::app {
 class BenchBackend;
+struct BenchDescription;
 }
 
 namespace synbench::cli {
@@ -41,6 +45,7 @@ class ConfiguredBench {
   ConfiguredBench& operator=(const ConfiguredBench&) = delete;
 
   drivers::ProfileBench& bench() { return *bench_; }
+  const drivers::ProfileBench& bench() const { return *bench_; }
   // "tcp 127.0.0.1:1502", "twin (in-process)", ...: the links, for messages.
   std::string describe() const;
   // The last error of each link that had one, one per line.
@@ -57,9 +62,11 @@ class ConfiguredBench {
   std::unique_ptr<drivers::ProfileBench> bench_;
 };
 
-// The daemon's bench on a bench config: ConfiguredBench behind the runtime's BenchBackend.
-// `load_b1_Nms_per_rad`: the load machine's friction the sweep engine uses for shaft power.
-std::unique_ptr<http::BenchBackend> make_configured_backend(LoadedBench bench, const emulator::TwinConfig& twin,
-                                                            double load_b1_Nms_per_rad);
+// The bench of a bench config, or the in-process twin without one. The twin's limits and
+// calibration follow its config; a bench config's come from its "limits", "setpoints" and
+// "calibration" (docs/bench-config.md), with the supervisor's defaults, never from the twin.
+std::unique_ptr<app::BenchBackend> make_backend(std::optional<LoadedBench> bench, const emulator::TwinConfig& twin);
+app::BenchDescription twin_description(const emulator::TwinConfig& twin);
+app::BenchDescription bench_description(const drivers::BenchConfig& config);
 
 }  // namespace synbench::cli

@@ -13,6 +13,7 @@ int sweep_command(const std::vector<std::string>& args);
 int emulate_command(const std::vector<std::string>& args);
 int serve_command(const std::vector<std::string>& args);
 int token_command(const std::vector<std::string>& args);
+int bench_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
@@ -20,5 +21,6 @@ extern const char* const kSweepHelp;
 extern const char* const kEmulateHelp;
 extern const char* const kServeHelp;
 extern const char* const kTokenHelp;
+extern const char* const kBenchHelp;
 
 }  // namespace synbench::cli

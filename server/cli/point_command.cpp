@@ -5,7 +5,10 @@
 #include <iostream>
 #include <memory>
 
+#include "app/bench_backend.hpp"
+#include "app/supervised_point.hpp"
 #include "bench/point_procedure.hpp"
+#include "bench/safety_supervisor.hpp"
 #include "drivers/bench_config.hpp"
 #include "emulator/firmware/estimators/factory.hpp"
 #include "emulator/twin_bench.hpp"
@@ -23,6 +26,9 @@ CPU allows): starts the drives, brings the bench to the point, waits for steady 
 one window on every instrument at once, prints one record, and ends with the ordered stop.
 With --bench, the same procedure runs through the device profiles and Modbus links the bench
 config names: on real drives, on `synbench emulate`, or on the twin's register map in-process.
+The safety supervisor watches every tick (the bench config's "limits"): a limit, a drive fault
+or a lost link ends the point with its ordered stop (exit 3), and a point that fails on a
+device error is stopped in order too.
 
 required:
   --speed-rpm N      SynRM speed setpoint, 0 < N <= firmware.max_speed_rpm (1500)
@@ -81,6 +87,7 @@ int point_command(const std::vector<std::string>& argv) {
   bool json = false;
   std::optional<drivers::BenchConfig> bench_config;
   std::optional<drivers::BenchProfiles> profiles;
+  bool bench_config_given = false;
   try {
     Args a(argv, {"--json", "--help"},
            {"--speed-rpm", "--load-Nm", "--angle-deg", "--pwm", "--estimator", "--udc-V",
@@ -134,6 +141,7 @@ int point_command(const std::vector<std::string>& argv) {
       config.sim.seed_int = static_cast<int>(*seed);
     }
     if (auto file = a.text("--bench")) {
+      bench_config_given = true;
       auto loaded = load_bench_or_throw(*file, "--bench");
       bench_config = std::move(loaded.config);
       profiles = std::move(loaded.profiles);
@@ -151,40 +159,41 @@ int point_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
+  std::optional<LoadedBench> loaded;
+  if (bench_config) loaded = LoadedBench{std::move(*bench_config), std::move(*profiles)};
+  auto backend = make_backend(std::move(loaded), config);
+  const app::BenchDescription& bench = backend->description();
   bench::PointOptions options;
-  options.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
-  std::unique_ptr<emulator::TwinBench> twin_bench;
-  std::unique_ptr<ConfiguredBench> configured;
-  drivers::BenchDevices devices;
-  drivers::Clock* clock = nullptr;
-  if (bench_config) {
-    configured = std::make_unique<ConfiguredBench>(*bench_config, std::move(*profiles), config);
-    devices = configured->bench().devices();
-    clock = &configured->bench().clock();
-    options.tick_s = bench_config->poll_period_ms / 1000.0;
-  } else {
-    twin_bench = std::make_unique<emulator::TwinBench>(config);
-    devices = twin_bench->devices();
-    clock = &twin_bench->clock();
-  }
-  const auto proc = bench::run_point(devices, *clock, req, options);
+  options.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
+  options.tick_s = bench.poll_period_s;
+  // The same supervisor as the daemon's and a sweep's, on the bench's own limits.
+  bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [](const std::string& kind, const std::string& m) {
+    if (kind == "fault" || kind == "alarm") std::cerr << "synbench point: " << kind << ": " << m << "\n";
+  });
+  const auto result = app::run_supervised_point(*backend, supervisor, req, options);
+  const auto& proc = result.procedure;
+  const double bench_s = backend->clock().now_s();
+  if (result.alarm) std::cerr << "synbench point: ALARM: " << result.alarm->detail << "\n";
   if (!proc.has_record()) {
-    std::cerr << "synbench point: " << proc.error() << "\n";
-    if (configured) std::cerr << configured->link_errors();
-    return 1;
+    if (result.trip)
+      std::cerr << "synbench point: the safety supervisor tripped (" << drivers::fault_name(result.trip->fault) << ": "
+                << result.trip->detail << "); the bench was stopped in order\n";
+    else
+      std::cerr << "synbench point: " << proc.error() << (result.stopped_after_failure ? "; the bench was stopped in order" : "")
+                << "\n";
+    std::cerr << backend->link_errors();
+    return result.trip ? 3 : 1;
   }
   if (json) {
     std::cout << bench::to_json(proc.record()).dump() << "\n";
-  } else if (configured) {
-    std::cout << "operating point (" << configured->describe() << ", " << clock->now_s()
+  } else {
+    std::cout << "operating point (" << (bench_config_given ? backend->links() : std::string("twin")) << ", " << bench_s
               << " s of bench time)\n"
               << bench::to_text(proc.record());
-  } else {
-    std::cout << "operating point (twin, " << clock->now_s() << " s of bench time)\n"
-              << bench::to_text(proc.record());
   }
-  if (proc.record().fault) {
-    std::cerr << "synbench point: " << proc.error() << "\n";
+  if (proc.record().fault || result.trip) {
+    std::cerr << "synbench point: "
+              << (result.trip ? "the safety supervisor tripped: " + result.trip->detail : proc.error()) << "\n";
     return 3;
   }
   return 0;

@@ -5,7 +5,10 @@
 #include <sys/stat.h>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <functional>
+#include <thread>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,7 +21,8 @@
 #include "server/cli/commands.hpp"
 #include "server/cli/serve_options.hpp"
 #include "server/http/api_routes.hpp"
-#include "server/http/bench_runtime.hpp"
+#include "app/bench_backend.hpp"
+#include "app/bench_runtime.hpp"
 #include "server/http/http_server.hpp"
 #include "server/http/router.hpp"
 #include "server/http/sweep_routes.hpp"
@@ -122,26 +126,25 @@ int serve_command(const std::vector<std::string>& argv) {
     return 1;
   }
 
-  std::unique_ptr<http::BenchBackend> backend;
-  std::string bench_what = "the in-process twin";
-  if (real_bench) {
-    bench_what = "the bench of " + options.bench->string();
-    backend = make_configured_backend(std::move(*real_bench), config, config.load.b1_Nms_per_rad);
-  } else {
-    backend = http::make_twin_backend(config);
-  }
-  http::BenchRuntime bench(config, bench::SafetyLimits{}, std::move(backend));
+  const std::string bench_what = real_bench ? "the bench of " + options.bench->string() : "the in-process twin";
+  // The bench thread logs what an operator must see in the journal: faults, alarms, stops.
+  const auto log = [](const app::BenchEvent& e) {
+    if (e.kind == "fault" || e.kind == "alarm" || e.kind == "stop" || e.kind == "state")
+      std::cerr << "synbench serve: bench " << e.kind << ": " << e.message << "\n";
+  };
+  app::BenchRuntime bench(make_backend(std::move(real_bench), config),
+                          [](const app::BenchStatus& s) { return http::status_json(s).dump(); }, log);
   http::HttpMetrics metrics;
   http::Router router([&tokens](std::string_view t) { return tokens.authenticate(t); });
   http::ControlLock control;
-  http::add_api_routes(router, {bench, control, metrics, synbench::kVersion});
+  http::add_api_routes(router, {bench, config, control, metrics, synbench::kVersion});
   // Stored with every sweep created here: the twin's config, or the bench config of the drives.
   nlohmann::ordered_json bench_meta = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
   if (options.bench) {
     std::ifstream in(*options.bench);
     bench_meta = {{"bench_file", options.bench->string()},
                   {"bench", nlohmann::ordered_json::parse(in, nullptr, false)},
-                  {"devices", nlohmann::ordered_json::parse(bench.describe_devices().dump())}};
+                  {"devices", nlohmann::ordered_json::parse(bench.devices_json().dump())}};
   }
   http::add_sweep_routes(router, *store, bench, control, data_dir / "synbench.db", bench_meta);
 
@@ -166,19 +169,36 @@ int serve_command(const std::vector<std::string>& argv) {
   }
   bench.start();
 
+  // The first SIGINT/SIGTERM brings the bench to its ordered stop on a thread of its own while
+  // the API still answers (an operator can still E-stop it); a second one is an E-stop.
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const boost::system::error_code& e, int sig) {
-    if (e) return;
-    std::cerr << "synbench serve: signal " << sig << ": ordered stop\n";
-    server.close();
-    hub->stop();
-    bench.shutdown();
-    io.stop();
-  });
+  std::thread stopper;
+  std::function<void()> await_signal = [&] {
+    signals.async_wait([&](const boost::system::error_code& e, int sig) {
+      if (e) return;
+      if (!stopper.joinable()) {
+        std::cerr << "synbench serve: signal " << sig << ": ordered stop (another signal: E-stop)\n";
+        stopper = std::thread([&] {
+          bench.shutdown();
+          boost::asio::post(io, [&] {
+            server.close();
+            hub->stop();
+            io.stop();
+          });
+        });
+      } else {
+        std::cerr << "synbench serve: signal " << sig << ": E-stop\n";
+        bench.estop("E-stop (signal " + std::to_string(sig) + ")", {});
+      }
+      await_signal();
+    });
+  };
+  await_signal();
   const bool v6 = host.find(':') != std::string::npos;
   std::cout << "listening on http://" << (v6 ? "[" + host + "]" : host) << ":" << server.port() << std::endl;
   std::cerr << "synbench serve: bench: " << bench_what << "\n";
   io.run();
+  if (stopper.joinable()) stopper.join();
   bench.shutdown();
   std::cerr << "synbench serve: stopped\n";
   return 0;

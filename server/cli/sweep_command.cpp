@@ -16,9 +16,12 @@
 #include "bench/sweep_plan.hpp"
 #include "db/export.hpp"
 #include "db/store.hpp"
-#include "emulator/twin_bench.hpp"
+#include "app/bench_backend.hpp"
+#include "app/supervised_point.hpp"
+#include "app/sweep_run.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
+#include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
 
 namespace synbench::cli {
@@ -27,13 +30,17 @@ const char* const kSweepHelp = R"(usage: synbench sweep PLAN.json [options]
        synbench sweep --resume ID [options]
 
 Runs a sweep plan (docs/sweep-plan.md) headless on the in-process twin, on virtual time, as fast
-as the CPU allows. Every measured point is committed to the SQLite database before the next one
-starts; a sweep interrupted by a crash, a fault or Ctrl-C resumes at its first missing point.
+as the CPU allows, or with --bench on the drives of a bench config (real drives, `synbench
+emulate`) in real time. The safety supervisor watches every tick, on the stricter of the bench's
+and the plan's limits, and stops the bench in order on any trip. Every measured point is
+committed to the SQLite database before the next one starts; a sweep interrupted by a crash, a
+fault or Ctrl-C resumes at its first missing point.
 
 options:
   --db FILE           database file (default synbench.db; created if missing)
   --resume ID         continue sweep ID from the database (its stored plan is used)
   --config FILE       twin config JSON (docs/emulator-config.md)
+  --bench FILE        bench config JSON (docs/bench-config.md): its drives instead of the twin
   --export-csv FILE   write the sweep's points as CSV when it ends
   --export-json FILE  write the sweep's points as JSON when it ends
   --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
@@ -60,28 +67,25 @@ std::string hms(double s) {
   return buf;
 }
 
-// Persists points and events in the store and draws progress.
-class StoreSink final : public bench::SweepSink {
+// Told by the sweep run of each committed point, event and progress step: draws progress.
+class ProgressPrinter final : public bench::SweepSink {
  public:
-  StoreSink(db::Store& store, std::int64_t sweep_id, bool quiet, bool print_committed)
-      : store_(store), id_(sweep_id), quiet_(quiet), print_committed_(print_committed),
+  ProgressPrinter(std::int64_t sweep_id, bool quiet, bool print_committed)
+      : id_(sweep_id), quiet_(quiet), print_committed_(print_committed),
         tty_(isatty(STDERR_FILENO) != 0),
         start_(std::chrono::steady_clock::now()) {}
 
-  std::error_code store_point(std::size_t index, const bench::PointRecord& r) override {
-    const auto st = store_.insert_point(id_, static_cast<std::int64_t>(index), r);
-    if (!st) last_error_ = st.error().message;
-    if (st && print_committed_) {
+  // Called once the point is committed.
+  std::error_code store_point(std::size_t index, const bench::PointRecord&) override {
+    if (print_committed_) {
       std::printf("committed %zu\n", index);
       std::fflush(stdout);
     }
     ++stored_this_run_;
-    return st.code();
+    return {};
   }
   void event(const std::string& kind, const std::string& message) override {
-    const auto k = kind == "fault" ? db::EventKind::fault : kind == "state" ? db::EventKind::state : db::EventKind::log;
-    (void)store_.add_event(id_, k, message);
-    if (!quiet_ && kind == "fault") std::cerr << (tty_ ? "\n" : "") << "fault: " << message << "\n";
+    if (!quiet_ && (kind == "fault" || kind == "alarm")) std::cerr << (tty_ ? "\n" : "") << kind << ": " << message << "\n";
   }
   void progress(const bench::SweepProgress& p) override {
     if (quiet_) return;
@@ -107,16 +111,13 @@ class StoreSink final : public bench::SweepSink {
   void finish_line() const {
     if (!quiet_ && tty_) std::fprintf(stderr, "\n");
   }
-  const std::string& last_error() const { return last_error_; }
 
  private:
-  db::Store& store_;
   std::int64_t id_;
   bool quiet_, print_committed_, tty_;
   std::chrono::steady_clock::time_point start_;
   std::size_t stored_this_run_ = 0;
   double last_line_ = -1e9;
-  std::string last_error_;
 };
 
 bool write_file(const std::string& path, const std::string& text) {
@@ -134,9 +135,11 @@ int sweep_command(const std::vector<std::string>& argv) {
   std::optional<std::int64_t> resume;
   std::optional<std::string> csv, json_out, analysis_out;
   bool quiet = false, print_committed = false;
+  std::optional<LoadedBench> loaded;
+  std::string bench_file;
   try {
     Args a(argv, {"--quiet", "--print-committed", "--help"},
-           {"--db", "--resume", "--config", "--export-csv", "--export-json", "--analysis"});
+           {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
       return 0;
@@ -148,6 +151,13 @@ int sweep_command(const std::vector<std::string>& argv) {
     json_out = a.text("--export-json");
     analysis_out = a.text("--analysis");
     if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+    if (auto file = a.text("--bench")) {
+      loaded = load_bench_or_throw(*file, "--bench");
+      bench_file = *file;
+      if (!loaded->config.on_twin() && a.text("--config"))
+        throw UsageError("--config", "configures the in-process twin, which this bench config does not use; give it to "
+                                     "synbench emulate");
+    }
     if (auto r = a.number("--resume")) {
       if (*r < 1 || *r != std::floor(*r)) throw UsageError("--resume", "must be a sweep id (a whole number >= 1)");
       resume = static_cast<std::int64_t>(*r);
@@ -215,7 +225,12 @@ int sweep_command(const std::vector<std::string>& argv) {
     db::SweepMeta meta;
     meta.name = plan->name.empty() ? "sweep" : plan->name;
     meta.plan = bench::to_json(*plan);
-    meta.bench_config = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+    if (loaded) {
+      std::ifstream in(bench_file);
+      meta.bench_config = {{"bench_file", bench_file}, {"bench", nlohmann::ordered_json::parse(in, nullptr, false)}};
+    } else {
+      meta.bench_config = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+    }
     const auto est = bench::estimate(*plan);
     meta.total_points = static_cast<std::int64_t>(est.points);
     auto created = store.create_sweep(meta);
@@ -225,45 +240,50 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
     id = *created;
   }
-  const bool sparse = plan->mode == bench::SweepMode::adaptive;
   if (!quiet) std::cerr << "sweep " << id << " (" << db_path << "): " << stored.size() << " points stored before this run\n";
-  (void)store.set_sweep_state(id, db::SweepState::running);
 
-  emulator::TwinBench twin(config);
-  bench::SafetySupervisor supervisor(twin.devices(), bench::safety_limits(*plan), [&](const std::string& k, const std::string& m) {
-    (void)store.add_event(id, k == "fault" ? db::EventKind::fault : db::EventKind::state, m);
+  auto backend = make_backend(std::move(loaded), config);
+  const app::BenchDescription& bench = backend->description();
+  bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [&](const std::string& k, const std::string& m) {
+    (void)store.add_event(id, k == "fault" || k == "alarm" ? db::EventKind::fault : db::EventKind::state, m);
+    if (!quiet && k == "alarm") std::cerr << "ALARM: " << m << "\n";
   });
-  StoreSink sink(store, id, quiet, print_committed);
-  bench::SweepBench bench_cal;
-  bench_cal.load_b1_Nms_per_rad = config.load.b1_Nms_per_rad;
-  bench::SweepEngine engine(twin.devices(), supervisor, *plan, std::move(stored), sink, bench_cal);
+  ProgressPrinter printer(id, quiet, print_committed);
+  app::SweepRunOptions run_options;
+  run_options.calibration.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
+  run_options.observer = &printer;
+  // The same runner as the daemon's: the stricter of the bench's and the plan's limits.
+  app::SweepRun run(backend->devices(), supervisor, store, id, *plan, std::move(stored), run_options);
+  if (auto e = run.begin()) {
+    std::cerr << "synbench sweep: " << *e << "\n";
+    return 1;
+  }
 
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_sigint);
-  const double tick_s = 0.01;
-  double t = twin.clock().now_s();
+  const double tick_s = bench.poll_period_s;
+  double t = backend->clock().now_s();
   bool abort_sent = false;
-  while (!engine.finished()) {
+  while (!run.finished()) {
     if (g_interrupted && !abort_sent) {
-      engine.abort();
+      run.engine().abort();
       abort_sent = true;
       if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
     }
     t += tick_s;
-    twin.clock().wait_until(t);
+    backend->clock().wait_until(t);
+    backend->tick(t);
     supervisor.tick(t);
-    engine.tick(t);
+    run.tick(t);
   }
+  // However the sweep ended, the drives are read back stopped (or the alarm is raised).
+  app::confirm_stopped(*backend, supervisor, t, tick_s);
   std::signal(SIGINT, previous);
-  sink.finish_line();
+  printer.finish_line();
 
-  const auto final_state = engine.state() == bench::SweepState::completed ? db::SweepState::completed
-                           : engine.state() == bench::SweepState::aborted ? db::SweepState::aborted
-                                                                          : db::SweepState::faulted;
-  std::optional<std::string> err;
-  if (!engine.error().empty()) err = engine.error();
-  if (auto st = store.set_sweep_state(id, final_state, err, sparse); !st)
-    std::cerr << "synbench sweep: recording the final state: " << st.error().message << "\n";
+  const auto final_state = run.final_state();
+  if (auto e = run.finish()) std::cerr << "synbench sweep: recording the final state: " << *e << "\n";
+  const std::string engine_error = run.engine().error();
 
   auto rows = store.points(id);
   if (!rows) {
@@ -271,6 +291,10 @@ int sweep_command(const std::vector<std::string>& argv) {
     return 1;
   }
   int status = final_state == db::SweepState::completed ? 0 : final_state == db::SweepState::aborted ? 130 : 1;
+  if (supervisor.alarm()) {
+    std::cerr << "synbench sweep: ALARM: " << supervisor.alarm()->detail << "\n";
+    status = 1;
+  }
   if (csv && !write_file(*csv, db::points_to_csv(*rows))) {
     std::cerr << "synbench sweep: --export-csv: cannot write '" << *csv << "'\n";
     status = 1;
@@ -289,7 +313,7 @@ int sweep_command(const std::vector<std::string>& argv) {
   }
   if (!quiet)
     std::cerr << "sweep " << id << " " << db::name(final_state) << ": " << rows->size() << " points in " << db_path
-              << (engine.error().empty() ? "" : " (" + engine.error() + ")") << "\n";
+              << (engine_error.empty() ? "" : " (" + engine_error + ")") << "\n";
   return status;
 }
 

@@ -67,9 +67,9 @@ std::string fmt(double v) {
   return s.str();
 }
 
-Response refusal_or_ok(const std::optional<Refusal>& r, BenchRuntime& bench) {
-  if (r) return error_response(r->status, r->code, r->message);
-  return json_response(200, status_json(bench.status()));
+// Hands the bench's answer to the HTTP reply.
+BenchRuntime::Done answer(Reply reply, int ok_status = 200) {
+  return [reply = std::move(reply), ok_status](app::Outcome o) { reply(outcome_response(o, ok_status)); };
 }
 
 // Rejects fields other than `known`, so a typo ("speed") is an error instead of a no-op.
@@ -88,6 +88,29 @@ nlohmann::json number_schema(double min, double max, const std::string& desc) {
 }
 
 }  // namespace
+
+int http_status(app::Refused r) {
+  switch (r) {
+    case app::Refused::device_error: return 502;
+    case app::Refused::database: return 500;
+    case app::Refused::queue_full:
+    case app::Refused::shutting_down: return 503;
+    default: return 409;
+  }
+}
+
+Response status_response(const app::StatusSnapshot& s) {
+  Response r;
+  r.body = s.text;
+  return r;
+}
+
+Response outcome_response(const app::Outcome& o, int ok_status) {
+  if (o.refusal) return error_response(http_status(o.refusal->code), std::string(app::name(o.refusal->code)), o.refusal->message);
+  Response r = status_response(*o.snapshot);
+  r.status = ok_status;
+  return r;
+}
 
 Response locked(const ControlLock& lock) {
   const auto d = lock.describe();
@@ -113,6 +136,7 @@ nlohmann::json status_json(const BenchStatus& s) {
   j["t_s"] = s.t_s;
   j["enabled"] = s.enabled;
   j["stopping"] = s.stopping;
+  j["heartbeats"] = s.heartbeats;
   j["setpoints"] = {{"speed_rpm", s.setpoints.speed_rpm}, {"load_Nm", s.setpoints.load_Nm}, {"angle_deg", s.setpoints.angle_deg}};
   j["mode"] = {{"estimator", std::string(drivers::name(s.mode.estimator))}, {"pwm", std::string(drivers::name(s.mode.pwm))}};
   if (s.synrm) {
@@ -135,6 +159,7 @@ nlohmann::json status_json(const BenchStatus& s) {
   j["supervisor"] = {{"phase", phase_name(s.phase)}, {"tripped", s.trip.has_value()}};
   if (s.trip)
     j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))}, {"detail", s.trip->detail}, {"at_s", s.trip->at_s}};
+  j["supervisor"]["alarm"] = s.alarm ? nlohmann::json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : nlohmann::json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
   if (s.sweep)
     j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
@@ -156,6 +181,8 @@ std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint6
   gauge("synbench_bench_time_seconds", "Bench (twin) time since the daemon started.", s.t_s);
   gauge("synbench_bench_enabled", "1 while the drives are enabled by an operator.", s.enabled ? 1 : 0);
   gauge("synbench_supervisor_tripped", "1 while the safety supervisor's trip is latched.", s.trip ? 1 : 0);
+  gauge("synbench_supervisor_alarm", "1 while a drive has not read back stopped after its disable.", s.alarm ? 1 : 0);
+  gauge("synbench_heartbeats", "1 while the drives' watchdog heartbeats are sent (0 after an E-stop).", s.heartbeats ? 1 : 0);
   if (s.synrm) {
     gauge("synbench_synrm_speed_rpm", "SynRM speed.", s.synrm->speed_rpm);
     gauge("synbench_synrm_current_A", "SynRM current magnitude.", s.synrm->im_A);
@@ -183,14 +210,15 @@ void add_api_routes(Router& router, ApiContext ctx) {
   HttpMetrics* metrics = &ctx.metrics;
   const Router* self = &router;
   const std::string version = ctx.version;
-  const double max_speed_rpm = bench->config().firmware.max_speed_rpm;
+  const double max_speed_rpm = bench->description().max_speed_rpm;
+  const double max_load_Nm = bench->description().max_load_Nm;
   ControlLock* control = &ctx.control;
-  constexpr double kMaxLoad_Nm = 10.0;  // beyond the 0.55 kW machine's rating; the supervisor guards current
 
-  add_info_routes(router, *bench);
+  add_info_routes(router, *bench, ctx.twin);
   router.add({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
               [bench, version](const Request&) {
-                const auto s = bench->status();
+                const auto snap = bench->snapshot();
+                const auto& s = snap->status;
                 return json_response(200, {{"status", "ok"}, {"version", version}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
               }});
   router.add({"GET", "/api/openapi.json", Role::anyone, "This API as an OpenAPI 3 document.",
@@ -199,16 +227,16 @@ void add_api_routes(Router& router, ApiContext ctx) {
               [bench, metrics](const Request&) {
                 Response r;
                 r.content_type = "text/plain; version=0.0.4";
-                r.body = prometheus_text(bench->status(), metrics->by_status(), metrics->ws());
+                r.body = prometheus_text(bench->snapshot()->status, metrics->by_status(), metrics->ws());
                 return r;
               }});
   router.add({"GET", "/api/bench/status", Role::viewer,
               "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
-              [bench](const Request&) { return json_response(200, status_json(bench->status())); }});
+              [bench](const Request&) { return status_response(*bench->snapshot()); }});
   router.add({"GET", "/api/bench/config", Role::viewer, "Limits the bench's setpoints are validated against.",
-              [max_speed_rpm, kMaxLoad_Nm](const Request&) {
+              [max_speed_rpm, max_load_Nm](const Request&) {
                 return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},
-                                           {"load_Nm", {{"min", 0}, {"max", kMaxLoad_Nm}}},
+                                           {"load_Nm", {{"min", 0}, {"max", max_load_Nm}}},
                                            {"angle_deg", {{"min_exclusive", 0}, {"max_exclusive", 90}}},
                                            {"tick_ms", BenchRuntime::kTick.count()}});
               }});
@@ -225,54 +253,55 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 if (!control->release(req.caller_id)) return locked(*control);
                 return json_response(200, control->describe());
               }});
-  router.add({"POST", "/api/bench/estop", Role::operator_, "E-stop: both drives disabled at once; latched until reset.",
-              [bench](const Request&) {
-                bench->estop();
-                return json_response(200, status_json(bench->status()));
-              }});
+  router.add({"POST", "/api/bench/estop", Role::operator_,
+              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once and read back; "
+              "latched until reset. Answers once the bench has acted.",
+              AsyncHandler([bench](const Request& req, Reply reply) {
+                bench->estop("E-stop (" + (req.caller_id.empty() ? std::string("REST") : req.caller_id) + ")",
+                             answer(std::move(reply)));
+              })});
   router.add({"POST", "/api/bench/reset", Role::operator_,
-              "Clear the supervisor's latched trip and the drives' faults (refused during an ordered stop).",
-              [bench, control](const Request& req) {
-                if (!control->claim(req.caller_id)) return locked(*control);
-                return refusal_or_ok(bench->reset(), *bench);
-              }});
+              "Clear the supervisor's latched trip and the drives' faults, resume the heartbeats (refused during an "
+              "ordered stop or while a drive still reads back running).",
+              AsyncHandler([bench, control](const Request& req, Reply reply) {
+                if (!control->claim(req.caller_id)) return reply(locked(*control));
+                bench->reset(answer(std::move(reply)));
+              })});
   router.add({"POST", "/api/bench/enable", Role::operator_,
               "Enable both drives with the current setpoints, or disable them by the ordered stop.",
-              [bench, control](const Request& req) {
-                if (!control->claim(req.caller_id)) return locked(*control);
+              AsyncHandler([bench, control](const Request& req, Reply reply) {
+                if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
                 const auto& doc = std::get<nlohmann::json>(parsed);
-                if (auto r = unknown_fields(doc, {"enabled"})) return *r;
-                if (!doc.contains("enabled")) return bad_field("enabled", "required");
-                if (!doc["enabled"].is_boolean()) return bad_field("enabled", "must be true or false");
-                return refusal_or_ok(bench->enable(doc["enabled"].get<bool>()), *bench);
-              },
+                if (auto r = unknown_fields(doc, {"enabled"})) return reply(*r);
+                if (!doc.contains("enabled")) return reply(bad_field("enabled", "required"));
+                if (!doc["enabled"].is_boolean()) return reply(bad_field("enabled", "must be true or false"));
+                bench->enable(doc["enabled"].get<bool>(), answer(std::move(reply)));
+              }),
               nlohmann::json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
   router.add({"POST", "/api/bench/mode", Role::operator_,
               "Choose the estimator and/or PWM scheme manual operation runs with (drives disabled).",
-              [bench, control](const Request& req) {
-                if (!control->claim(req.caller_id)) return locked(*control);
+              AsyncHandler([bench, control](const Request& req, Reply reply) {
+                if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
                 const auto& doc = std::get<nlohmann::json>(parsed);
-                if (auto r = unknown_fields(doc, {"estimator", "pwm"})) return *r;
-                if (doc.empty()) return error_response(400, "bad_field", "give estimator and/or pwm");
-                DriveMode mode = bench->status().mode;
+                if (auto r = unknown_fields(doc, {"estimator", "pwm"})) return reply(*r);
+                if (doc.empty()) return reply(error_response(400, "bad_field", "give estimator and/or pwm"));
+                app::DriveModeUpdate mode;
                 if (doc.contains("estimator")) {
                   const auto& v = doc["estimator"];
-                  const auto e = v.is_string() ? drivers::parse_estimator(v.get<std::string>()) : std::nullopt;
-                  if (!e) return bad_field("estimator", "must be one of " + join(drivers::kEstimatorNames));
-                  mode.estimator = *e;
+                  mode.estimator = v.is_string() ? drivers::parse_estimator(v.get<std::string>()) : std::nullopt;
+                  if (!mode.estimator) return reply(bad_field("estimator", "must be one of " + join(drivers::kEstimatorNames)));
                 }
                 if (doc.contains("pwm")) {
                   const auto& v = doc["pwm"];
-                  const auto p = v.is_string() ? drivers::parse_pwm(v.get<std::string>()) : std::nullopt;
-                  if (!p) return bad_field("pwm", "must be one of " + join(drivers::kPwmNames));
-                  mode.pwm = *p;
+                  mode.pwm = v.is_string() ? drivers::parse_pwm(v.get<std::string>()) : std::nullopt;
+                  if (!mode.pwm) return reply(bad_field("pwm", "must be one of " + join(drivers::kPwmNames)));
                 }
-                return refusal_or_ok(bench->set_mode(mode), *bench);
-              },
+                bench->set_mode(mode, answer(std::move(reply)));
+              }),
               nlohmann::json{{"type", "object"},
                              {"additionalProperties", false},
                              {"properties",
@@ -280,41 +309,42 @@ void add_api_routes(Router& router, ApiContext ctx) {
                                {"pwm", {{"type", "string"}, {"enum", drivers::kPwmNames}}}}}}});
   router.add({"POST", "/api/bench/setpoints", Role::operator_,
               "Set speed_rpm, load_Nm and/or angle_deg (omitted fields keep their value).",
-              [bench, control, max_speed_rpm, kMaxLoad_Nm](const Request& req) {
-                if (!control->claim(req.caller_id)) return locked(*control);
+              AsyncHandler([bench, control, max_speed_rpm, max_load_Nm](const Request& req, Reply reply) {
+                if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return *r;
+                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
                 const auto& doc = std::get<nlohmann::json>(parsed);
-                if (auto r = unknown_fields(doc, {"speed_rpm", "load_Nm", "angle_deg"})) return *r;
-                if (doc.empty()) return error_response(400, "bad_field", "give at least one of speed_rpm, load_Nm, angle_deg");
-                Setpoints sp = bench->status().setpoints;
+                if (auto r = unknown_fields(doc, {"speed_rpm", "load_Nm", "angle_deg"})) return reply(*r);
+                if (doc.empty())
+                  return reply(error_response(400, "bad_field", "give at least one of speed_rpm, load_Nm, angle_deg"));
+                app::SetpointsUpdate sp;
                 struct Field {
                   const char* name;
-                  double* value;
+                  std::optional<double>* value;
                   double lo, hi;
                   bool open;  // exclusive bounds
                 };
                 const Field fields[] = {{"speed_rpm", &sp.speed_rpm, 0, max_speed_rpm, false},
-                                        {"load_Nm", &sp.load_Nm, 0, kMaxLoad_Nm, false},
+                                        {"load_Nm", &sp.load_Nm, 0, max_load_Nm, false},
                                         {"angle_deg", &sp.angle_deg, 0, 90, true}};
                 for (const Field& f : fields) {
                   if (!doc.contains(f.name)) continue;
                   const auto& v = doc[f.name];
-                  if (!v.is_number()) return bad_field(f.name, "must be a number");
+                  if (!v.is_number()) return reply(bad_field(f.name, "must be a number"));
                   const double x = v.get<double>();
                   const bool ok = std::isfinite(x) && (f.open ? (x > f.lo && x < f.hi) : (x >= f.lo && x <= f.hi));
                   if (!ok)
-                    return bad_field(f.name, fmt(x) + " is outside " + (f.open ? "(" : "[") + fmt(f.lo) + ", " + fmt(f.hi) +
-                                                 (f.open ? ")" : "]"));
+                    return reply(bad_field(f.name, fmt(x) + " is outside " + (f.open ? "(" : "[") + fmt(f.lo) + ", " +
+                                                       fmt(f.hi) + (f.open ? ")" : "]")));
                   *f.value = x;
                 }
-                return refusal_or_ok(bench->set_setpoints(sp), *bench);
-              },
+                bench->set_setpoints(sp, answer(std::move(reply)));
+              }),
               nlohmann::json{{"type", "object"},
                              {"additionalProperties", false},
                              {"properties",
                               {{"speed_rpm", number_schema(0, max_speed_rpm, "SynRM speed setpoint")},
-                               {"load_Nm", number_schema(0, kMaxLoad_Nm, "braking torque of the load")},
+                               {"load_Nm", number_schema(0, max_load_Nm, "braking torque of the load")},
                                {"angle_deg", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 90}, {"exclusiveMaximum", true}, {"description", "current angle"}}}}}}});
 }
 

@@ -13,10 +13,15 @@
 #include <string>
 #include <variant>
 
-#include "server/http/bench_runtime.hpp"
+#include "app/bench_runtime.hpp"
+#include "emulator/twin_config.hpp"
 #include "server/http/router.hpp"
 
 namespace synbench::http {
+
+using app::BenchRuntime;
+using app::BenchEvent;
+using app::BenchStatus;
 
 // Request counts by status, for /metrics.
 // WebSocket clients connected now and dropped so far (slow readers), for /metrics.
@@ -90,6 +95,7 @@ Response locked(const ControlLock& lock);
 
 struct ApiContext {
   BenchRuntime& bench;
+  const emulator::TwinConfig& twin;  // the firmware's estimator settings (GET /api/estimators)
   ControlLock& control;
   HttpMetrics& metrics;
   std::string version;
@@ -103,6 +109,13 @@ void add_api_routes(Router& router, ApiContext ctx);
 std::variant<nlohmann::json, Response> parse_json_object(const std::string& body);
 
 nlohmann::json status_json(const BenchStatus& s);
+// The bench's refusal as an HTTP status: 409 for the bench's state, 502 for a device, 503 while
+// the daemon stops or its queue is full, 500 for the store.
+int http_status(app::Refused r);
+// A command's outcome: its refusal as an error, else `ok_status` with the status after it.
+Response outcome_response(const app::Outcome& o, int ok_status = 200);
+// The snapshot's status text as a 200.
+Response status_response(const app::StatusSnapshot& s);
 // The supervisor's phase as the API names it: "normal", "stopping_load", ... "estopped".
 const char* phase_name(bench::SafetyPhase p);
 std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,

@@ -156,23 +156,43 @@ class Session : public std::enable_shared_from_this<Session> {
       }
     } else if (routed(path) || !shared_->files) {
       const auto auth = req[bhttp::field::authorization];
-      r = shared_->router.dispatch(method, target, std::string_view(auth.data(), auth.size()), std::move(req.body()));
+      // A bench command answers from the bench thread once it has acted: the answer comes back
+      // to this session's strand, and the io thread serves others meanwhile.
+      const Meta meta{method, path, req.version(), keep_alive, req.method() == bhttp::verb::head};
+      shared_->router.dispatch_async(method, target, std::string_view(auth.data(), auth.size()), std::move(req.body()),
+                                     [self = shared_from_this(), meta](Response answer) {
+                                       net::post(self->stream_.get_executor(), [self, meta, answer = std::move(answer)]() mutable {
+                                         self->respond(meta, std::move(answer));
+                                       });
+                                     });
+      return;
     } else {
       // The dashboard's files need no token: the page signs in itself.
       const auto inm = req[bhttp::field::if_none_match];
       r = shared_->files->serve(method, target, std::string_view(inm.data(), inm.size()));
     }
-    if (shared_->observer) shared_->observer(method, path, r.status);
-    auto res = std::make_shared<bhttp::response<bhttp::string_body>>(static_cast<bhttp::status>(r.status), req.version());
+    respond({method, path, req.version(), keep_alive, req.method() == bhttp::verb::head}, std::move(r));
+  }
+
+  // What the answer to a request needs to know of it.
+  struct Meta {
+    std::string method, path;
+    unsigned version;
+    bool keep_alive, head;
+  };
+
+  void respond(const Meta& m, Response r) {
+    if (shared_->observer) shared_->observer(m.method, m.path, r.status);
+    auto res = std::make_shared<bhttp::response<bhttp::string_body>>(static_cast<bhttp::status>(r.status), m.version);
     res->set(bhttp::field::server, "synbench");
     res->set(bhttp::field::content_type, r.content_type);
     res->set(bhttp::field::cache_control, "no-store");
     res->set("X-Content-Type-Options", "nosniff");
     for (const auto& [k, v] : r.headers) res->set(k, v);
-    res->keep_alive(keep_alive);
+    res->keep_alive(m.keep_alive);
     res->body() = std::move(r.body);
     res->prepare_payload();
-    if (req.method() == bhttp::verb::head) res->body().clear();  // Content-Length stays that of GET
+    if (m.head) res->body().clear();  // Content-Length stays that of GET
     write(res);
   }
 

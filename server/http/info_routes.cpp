@@ -67,16 +67,15 @@ nlohmann::json profiles_json() {
 
 }  // namespace
 
-void add_info_routes(Router& router, BenchRuntime& bench) {
-  BenchRuntime* runtime = &bench;
+void add_info_routes(Router& router, const BenchRuntime& bench, const emulator::TwinConfig& twin) {
   router.add({"GET", "/api/whoami", Role::viewer, "The caller's role and identity label (never the token).",
               [](const Request& req) { return json_response(200, {{"role", role_name(req.caller)}, {"id", req.caller_id}}); }});
-  const nlohmann::json estimators = estimators_json(bench.config());
+  const nlohmann::json estimators = estimators_json(twin);
   router.add({"GET", "/api/estimators", Role::viewer,
               "Position sources the SynRM drive offers (POST /api/bench/mode selects one), with their speed ranges.",
               [estimators](const Request&) { return json_response(200, estimators); }});
   router.add({"GET", "/api/devices", Role::viewer, "The bench's devices: role, kind, backend, link, profile.",
-              [runtime](const Request&) { return json_response(200, runtime->describe_devices()); }});
+              [devices = bench.devices_json()](const Request&) { return json_response(200, devices); }});
   router.add({"GET", "/api/profiles", Role::viewer, "The default device profiles (docs/device-profile.md), as loaded.",
               [](const Request&) { return json_response(200, profiles_json()); }});
 }

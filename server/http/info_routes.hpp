@@ -2,11 +2,13 @@
 // drive offers, the bench's devices and the device profiles (docs/api.md).
 #pragma once
 
-#include "server/http/bench_runtime.hpp"
+#include "emulator/twin_config.hpp"
+#include "server/http/api_routes.hpp"
 #include "server/http/router.hpp"
 
 namespace synbench::http {
 
-void add_info_routes(Router& router, BenchRuntime& bench);
+// `twin`: the firmware's estimator settings the estimators route describes.
+void add_info_routes(Router& router, const BenchRuntime& bench, const emulator::TwinConfig& twin);
 
 }  // namespace synbench::http

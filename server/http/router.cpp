@@ -1,6 +1,11 @@
 // Route matching, bearer auth and the OpenAPI document of the route table.
 #include "server/http/router.hpp"
 
+#include <atomic>
+#include <future>
+#include <memory>
+#include <utility>
+
 #include <exception>
 #include <set>
 
@@ -108,6 +113,14 @@ void Router::add(Route route) { routes_.push_back(std::move(route)); }
 
 Response Router::dispatch(const std::string& method, const std::string& target, std::string_view authorization,
                           std::string body) const {
+  auto answer = std::make_shared<std::promise<Response>>();
+  auto future = answer->get_future();
+  dispatch_async(method, target, authorization, std::move(body), [answer](Response r) { answer->set_value(std::move(r)); });
+  return future.get();
+}
+
+void Router::dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
+                            std::string body, Reply reply) const {
   Request req;
   req.method = method;
   const std::size_t q = target.find('?');
@@ -129,12 +142,12 @@ Response Router::dispatch(const std::string& method, const std::string& target, 
     }
   }
   if (!route) {
-    if (allowed.empty()) return error_response(404, "not_found", "no route for " + req.path);
+    if (allowed.empty()) return reply(error_response(404, "not_found", "no route for " + req.path));
     std::string allow;
     for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
     Response r = error_response(405, "method_not_allowed", method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
     r.headers.emplace_back("Allow", allow);
-    return r;
+    return reply(std::move(r));
   }
 
   // The token is checked whenever one is given, so a bad token is reported even on open routes
@@ -155,20 +168,35 @@ Response Router::dispatch(const std::string& method, const std::string& target, 
       r.headers.emplace_back("WWW-Authenticate", "Bearer realm=\"synbench\"");
       return r;
     };
-    if (!token_given) return challenge(error_response(401, "unauthorized", "this route needs a bearer token (Authorization: Bearer TOKEN)"));
-    if (!caller) return challenge(error_response(401, "unauthorized", "the bearer token is not valid"));
+    if (!token_given) return reply(challenge(error_response(401, "unauthorized", "this route needs a bearer token (Authorization: Bearer TOKEN)")));
+    if (!caller) return reply(challenge(error_response(401, "unauthorized", "the bearer token is not valid")));
     if (static_cast<int>(caller->role) < static_cast<int>(route->role))
-      return error_response(403, "forbidden", std::string("this route needs the ") + role_name(route->role) +
-                                                  " role; the token has " + role_name(caller->role));
+      return reply(error_response(403, "forbidden", std::string("this route needs the ") + role_name(route->role) +
+                                                        " role; the token has " + role_name(caller->role)));
   }
   if (caller) {
     req.caller = caller->role;
     req.caller_id = caller->id;
   }
+  // Shared with the handler, which may answer from the bench thread: whichever side answers
+  // first (the handler, or the exception it threw here) is the one answer.
+  struct Once {
+    std::atomic<bool> used{false};
+    Reply reply;
+    void operator()(Response r) {
+      if (!used.exchange(true)) reply(std::move(r));
+    }
+  };
+  auto once = std::make_shared<Once>();
+  once->reply = std::move(reply);
   try {
-    return route->handler(req);
+    if (route->async_handler) {
+      route->async_handler(req, [once](Response r) { (*once)(std::move(r)); });
+      return;
+    }
+    (*once)(route->handler(req));
   } catch (const std::exception& e) {
-    return error_response(500, "internal", e.what());
+    (*once)(error_response(500, "internal", e.what()));
   }
 }
 

@@ -1,7 +1,9 @@
 // The daemon's REST surface as data: a route table (method, path pattern with {name} segments,
 // required role, OpenAPI summary, handler) and a pure dispatcher. Handlers are functions of the
 // request (their context captured when the table is built); nothing here touches a socket, so
-// routing, auth and the OpenAPI document are unit-tested without a server.
+// routing, auth and the OpenAPI document are unit-tested without a server. A handler either
+// answers at once, or (a bench command) hands a Reply to the bench thread and answers when the
+// bench has acted: the io thread never waits for a device.
 #pragma once
 
 #include <functional>
@@ -42,16 +44,23 @@ Response json_response(int status, const nlohmann::json& body);
 Response error_response(int status, const std::string& code, const std::string& message);
 
 using Handler = std::function<Response(const Request&)>;
+// Called exactly once, on any thread.
+using Reply = std::function<void(Response)>;
+using AsyncHandler = std::function<void(const Request&, Reply)>;
 
 struct Route {
   Route(std::string m, std::string p, Role r, std::string s, Handler h, std::optional<nlohmann::json> schema = std::nullopt)
       : method(std::move(m)), pattern(std::move(p)), role(r), summary(std::move(s)), handler(std::move(h)),
         request_schema(std::move(schema)) {}
+  Route(std::string m, std::string p, Role r, std::string s, AsyncHandler h, std::optional<nlohmann::json> schema = std::nullopt)
+      : method(std::move(m)), pattern(std::move(p)), role(r), summary(std::move(s)), async_handler(std::move(h)),
+        request_schema(std::move(schema)) {}
   std::string method;
   std::string pattern;  // "/api/sweeps/{id}/start"
   Role role = Role::viewer;
   std::string summary;  // one line, for the OpenAPI document and docs/api.md
-  Handler handler;
+  Handler handler;             // one of the two
+  AsyncHandler async_handler;
   std::optional<nlohmann::json> request_schema;  // JSON Schema of the body, if it takes one
 };
 
@@ -72,7 +81,11 @@ class Router {
 
   // `target` is the request-target ("/api/x?y=z"); `authorization` the Authorization header
   // (empty when absent). 404 unknown path, 405 wrong method, 401 no or unknown token, 403 role
-  // too low; otherwise the handler's response. Never throws: a handler's exception is a 500.
+  // too low; otherwise the handler's response, given to `reply` (at once, or from the bench
+  // thread). Never throws: a handler's exception is a 500.
+  void dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
+                      std::string body, Reply reply) const;
+  // The same, waiting for the answer: for tests and tools, never on the io thread.
   Response dispatch(const std::string& method, const std::string& target,
                     std::string_view authorization, std::string body) const;
 

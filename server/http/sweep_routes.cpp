@@ -87,38 +87,37 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
   ControlLock* lock = &control;
   router.add({"POST", "/api/sweeps/{id}/start", Role::operator_,
               "Run the sweep on the daemon's bench (a stopped one resumes at its first missing point).",
-              [db, runtime, lock, db_path](const Request& req) {
-                if (!lock->claim(req.caller_id)) return locked(*lock);
+              AsyncHandler([db, runtime, lock, db_path](const Request& req, Reply reply) {
+                if (!lock->claim(req.caller_id)) return reply(locked(*lock));
                 Response err;
                 const auto id = sweep_id(req, err);
-                if (!id) return err;
+                if (!id) return reply(err);
                 auto s = db->get_sweep(*id);
-                if (!s) return db_error(s.error());
+                if (!s) return reply(db_error(s.error()));
                 if (s->state == db::SweepState::completed)
-                  return error_response(409, "invalid_state", "sweep " + std::to_string(*id) + " is already completed");
+                  return reply(error_response(409, "invalid_state", "sweep " + std::to_string(*id) + " is already completed"));
                 auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(s->meta.plan.dump()));
-                if (!parsed.plan) return error_response(500, "bad_plan", "the stored plan no longer parses");
+                if (!parsed.plan) return reply(error_response(500, "bad_plan", "the stored plan no longer parses"));
                 auto rows = db->points(*id);
-                if (!rows) return db_error(rows.error());
+                if (!rows) return reply(db_error(rows.error()));
                 std::map<std::size_t, bench::PointRecord> stored;
                 for (const auto& row : *rows) stored[static_cast<std::size_t>(row.index)] = row.record;
-                if (auto r = runtime->start_sweep(*id, std::move(*parsed.plan), std::move(stored), db_path))
-                  return error_response(r->status, r->code, r->message);
-                return json_response(202, status_json(runtime->status()));
-              }});
+                runtime->start_sweep(*id, std::move(*parsed.plan), std::move(stored), db_path,
+                                     [reply = std::move(reply)](app::Outcome o) { reply(outcome_response(o, 202)); });
+              })});
   for (const char* action : {"pause", "resume", "abort"}) {
     const std::string a = action;
     const std::string summary = a == "pause"    ? "Pause the running sweep after its point in flight."
                                 : a == "resume" ? "Resume the paused sweep."
                                                 : "Abort the running sweep: drop the point in flight, ordered stop.";
-    router.add({"POST", "/api/sweeps/{id}/" + a, Role::operator_, summary, [runtime, lock, a](const Request& req) {
-                  if (!lock->claim(req.caller_id)) return locked(*lock);
+    router.add({"POST", "/api/sweeps/{id}/" + a, Role::operator_, summary,
+                AsyncHandler([runtime, lock, a](const Request& req, Reply reply) {
+                  if (!lock->claim(req.caller_id)) return reply(locked(*lock));
                   Response err;
                   const auto id = sweep_id(req, err);
-                  if (!id) return err;
-                  if (auto r = runtime->sweep_action(*id, a)) return error_response(r->status, r->code, r->message);
-                  return json_response(200, status_json(runtime->status()));
-                }});
+                  if (!id) return reply(err);
+                  runtime->sweep_action(*id, a, [reply = std::move(reply)](app::Outcome o) { reply(outcome_response(o)); });
+                })});
   }
   router.add({"POST", "/api/sweeps", Role::operator_,
               "Create a sweep from a plan (docs/sweep-plan.md): 201 with its id, state created.",

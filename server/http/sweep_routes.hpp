@@ -8,7 +8,6 @@
 
 #include "db/store.hpp"
 #include "server/http/api_routes.hpp"
-#include "server/http/bench_runtime.hpp"
 #include "server/http/router.hpp"
 
 namespace synbench::http {

@@ -116,7 +116,8 @@ void WsHub::on_tick() {
   }
   // Without sessions only the change tracking runs (so a later client is not sent history).
   const bool build = !targets.empty();
-  const BenchStatus s = bench_.status();
+  const auto snap = bench_.snapshot();  // the bench thread's immutable snapshot
+  const BenchStatus& s = snap->status;
   auto tick = std::make_shared<HubTick>();
   tick->index = index_;
   if (build) tick->telemetry = share(telemetry_message(s, unix_ms_now()));
@@ -133,6 +134,7 @@ void WsHub::on_tick() {
   // stop, phase, trip, setpoints, mode, sweep state, a new event. So a page need not poll.
   const std::string state_key =
       std::to_string(s.enabled) + std::to_string(s.stopping) + phase_name(s.phase) + std::to_string(s.trip.has_value()) +
+      std::to_string(s.alarm.has_value()) + std::to_string(s.heartbeats) +
       "|" + std::to_string(s.setpoints.speed_rpm) + "," + std::to_string(s.setpoints.load_Nm) + "," +
       std::to_string(s.setpoints.angle_deg) + "|" + std::string(drivers::name(s.mode.estimator)) +
       std::string(drivers::name(s.mode.pwm)) + "|" + (s.sweep ? std::to_string(s.sweep->id) + s.sweep->state : "") + "|" +

@@ -20,7 +20,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <nlohmann/json.hpp>
 
-#include "server/http/bench_runtime.hpp"
+#include "server/http/api_routes.hpp"
 #include "server/http/router.hpp"
 
 namespace synbench::http {

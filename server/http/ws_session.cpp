@@ -182,10 +182,10 @@ void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
   send(nlohmann::json{{"type", "subscribed"}, {"channel", channel}, {"rate_hz", rate}});
   if (channel == "sweep") {
     sweep_ = true;
-    send(std::make_shared<const std::string>(hub_->sweep_message(hub_->bench().status())));
+    send(std::make_shared<const std::string>(hub_->sweep_message(hub_->bench().snapshot()->status)));
   } else if (channel == "events") {
     events_ = true;
-    send(std::make_shared<const std::string>(state_message(hub_->bench().status())));
+    send(std::make_shared<const std::string>(state_message(hub_->bench().snapshot()->status)));
   }
 }
 
@@ -198,8 +198,15 @@ void WsSession::handle_request(const nlohmann::json& doc) {
   const nlohmann::json id = doc.contains("id") ? doc["id"] : nlohmann::json(nullptr);
   std::string body;
   if (doc.contains("body")) body = doc["body"].dump();
-  // Through the REST router with this session's token: the same roles, lock and validation.
-  const Response r = hub_->router().dispatch(doc["method"].get<std::string>(), doc["path"].get<std::string>(), "Bearer " + token_, std::move(body));
+  // Through the REST router with this session's token: the same roles, lock and validation. A
+  // bench command answers from the bench thread: the reply comes back to this session's strand.
+  hub_->router().dispatch_async(doc["method"].get<std::string>(), doc["path"].get<std::string>(), "Bearer " + token_,
+                                std::move(body), [self = shared_from_this(), id](Response r) {
+                                  net::post(self->ws_.get_executor(), [self, id, r = std::move(r)] { self->reply(id, r); });
+                                });
+}
+
+void WsSession::reply(const nlohmann::json& id, const Response& r) {
   nlohmann::json reply_body = r.body;  // a text body (metrics, CSV) stays a string
   if (r.content_type.rfind("application/json", 0) == 0) {
     try {

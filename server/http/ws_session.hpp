@@ -45,6 +45,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void handle_auth(const nlohmann::json& doc);
   void handle_subscribe(const nlohmann::json& doc, bool subscribe);
   void handle_request(const nlohmann::json& doc);
+  // Sends the router's answer to request `id`, on this session's strand.
+  void reply(const nlohmann::json& id, const Response& r);
   void bad_message(const std::string& message);
   // An `unauthorized` error, then close 1008 once it is written.
   void refuse(const std::string& message);

@@ -121,3 +121,42 @@ TEST(Twin, OwnOrderedStopRampsDownThenLatches) {
 
 }  // namespace
 }  // namespace synbench
+
+namespace synbench {
+namespace {
+
+// An E-stop from the master in the middle of the drive's own ordered stop (a watchdog's) turns
+// the gates off at once instead of being refused: the current is gone in the next period and
+// the watchdog's fault latches.
+TEST(Twin, DisableDuringTheDrivesOwnStopIsObeyed) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  auto& t = bench.twin();
+  auto d = bench.devices();
+  ASSERT_FALSE(d.synrm->set_angle_deg(56));
+  ASSERT_FALSE(d.synrm->set_speed_rpm(900));
+  ASSERT_FALSE(d.synrm->enable(true));
+  ASSERT_FALSE(d.load->enable(true));
+  bench.clock().wait_until(1.5);
+  ASSERT_FALSE(d.load->set_torque_Nm(2.0));
+  bench.clock().wait_until(3.0);
+  t.load_drive().stop_and_latch(drivers::Fault::watchdog);
+  t.synrm_drive().stop_and_latch(drivers::Fault::watchdog);
+  bench.clock().wait_until(3.05);
+  ASSERT_EQ(t.synrm_drive().state(), drivers::DriveState::stopping);
+  EXPECT_FALSE(d.synrm->enable(false));
+  EXPECT_FALSE(d.load->enable(false));
+  bench.clock().wait_until(3.06);
+  EXPECT_EQ(t.synrm_drive().state(), drivers::DriveState::faulted);
+  EXPECT_EQ(t.synrm_drive().fault(), drivers::Fault::watchdog);
+  drivers::LoadTelemetry lt;
+  ASSERT_FALSE(d.load->read(lt));
+  EXPECT_EQ(lt.state, drivers::DriveState::faulted);
+  drivers::SynrmTelemetry st;
+  ASSERT_FALSE(d.synrm->read(st));
+  EXPECT_GT(st.speed_rpm, 500) << "coasting, not ramped down: the gates went off";
+  bench.clock().wait_until(3.2);
+  EXPECT_LT(std::fabs(t.snapshot().load_torque_Nm), 1e-9);
+}
+
+}  // namespace
+}  // namespace synbench

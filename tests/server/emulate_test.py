@@ -132,7 +132,9 @@ tcp_cfg = bench_config("tcp_ok", {"transport": "tcp", "host": "127.0.0.1", "port
 code, out, err = run("point", *POINT, "--bench", tcp_cfg, "--seed", "3")
 check(code == 2 and "--seed" in err, f"--seed refused for a remote bench: {err.strip()}")
 code, out, err = run("point", *POINT, "--bench", tcp_cfg)
-check(code == 1 and "down" in err, f"point exits 1 when nothing answers: {err.strip()[:120]}")
+# Under the safety supervisor a link that never answers is a lost link: a latched fault (exit 3),
+# and the drives, which cannot be read back, raise the alarm.
+check(code == 3 and "link_loss" in err and "ALARM" in err, f"point exits 3 on a lost link: {err.strip()[:160]}")
 
 # --- mbpoll against the emulator -------------------------------------------------------------
 emu = Emulator("--tcp", "127.0.0.1:0")

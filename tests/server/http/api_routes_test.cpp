@@ -3,6 +3,9 @@
 // follows a speed setpoint.
 #include "server/http/api_routes.hpp"
 
+#include "app/bench_backend.hpp"
+#include "server/cli/bench_setup.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,19 +17,21 @@ namespace synbench::http {
 namespace {
 
 struct Api : ::testing::Test {
-  Api() : bench(emulator::TwinConfig{}, bench::SafetyLimits{}), router([](std::string_view t) -> std::optional<Identity> {
+  Api() : bench(cli::make_backend(std::nullopt, emulator::TwinConfig{}), [](const BenchStatus& s) { return status_json(s).dump(); }),
+          router([](std::string_view t) -> std::optional<Identity> {
             if (t == "op") return Identity{Role::operator_, "op"};
             if (t == "op2") return Identity{Role::operator_, "op2"};
             if (t == "view") return Identity{Role::viewer, "view"};
             return std::nullopt;
           }) {
-    add_api_routes(router, {bench, control, metrics, "test"});
+    add_api_routes(router, {bench, twin, control, metrics, "test"});
     bench.start();
   }
   ~Api() override { bench.shutdown(); }
   Response post(const std::string& path, const std::string& body, const std::string& token = "op") {
     return router.dispatch("POST", path, token.empty() ? "" : "Bearer " + token, body);
   }
+  emulator::TwinConfig twin;
   BenchRuntime bench;
   ControlLock control;
   HttpMetrics metrics;

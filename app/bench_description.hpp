@@ -1,0 +1,19 @@
+// What the application knows of the bench it runs on, whatever the devices are: the safety
+// limits its supervisor enforces, the setpoints an operator may ask for, the calibrations the
+// analysis needs, and how often the bench is polled. A bench config's "limits" and
+// "calibration" give it for real drives; for the in-process twin it follows the twin's config.
+#pragma once
+
+#include "bench/safety_supervisor.hpp"
+
+namespace synbench::app {
+
+struct BenchDescription {
+  bench::SafetyLimits limits;
+  double max_speed_rpm = 1500.0;        // setpoints accepted from an operator or a plan
+  double max_load_Nm = 10.0;
+  double load_b1_Nms_per_rad = 2.0e-4;  // the load machine's viscous friction (shaft power)
+  double poll_period_s = 0.01;          // telemetry reads of `synbench sweep` and `point`
+};
+
+}  // namespace synbench::app

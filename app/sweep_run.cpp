@@ -1,0 +1,71 @@
+// A sweep into the store; see sweep_run.hpp.
+#include "app/sweep_run.hpp"
+
+namespace synbench::app {
+
+class SweepRun::Sink final : public bench::SweepSink {
+ public:
+  Sink(db::Store& store, std::int64_t id, bench::SweepSink* observer) : store_(store), id_(id), observer_(observer) {}
+  std::error_code store_point(std::size_t index, const bench::PointRecord& r) override {
+    const auto st = store_.insert_point(id_, static_cast<std::int64_t>(index), r);
+    if (!st) {
+      event("fault", "storing point " + std::to_string(index) + " failed: " + st.error().message);
+      return st.code();
+    }
+    if (observer_) observer_->store_point(index, r);
+    return {};
+  }
+  void event(const std::string& kind, const std::string& message) override {
+    const auto k = kind == "fault" || kind == "alarm" ? db::EventKind::fault
+                   : kind == "state"                  ? db::EventKind::state
+                                                      : db::EventKind::log;
+    (void)store_.add_event(id_, k, message);
+    if (observer_) observer_->event(kind, message);
+  }
+  void progress(const bench::SweepProgress& p) override {
+    if (observer_) observer_->progress(p);
+  }
+
+ private:
+  db::Store& store_;
+  std::int64_t id_;
+  bench::SweepSink* observer_;
+};
+
+SweepRun::SweepRun(drivers::BenchDevices devices, bench::SafetySupervisor& supervisor, db::Store& store, std::int64_t id,
+                   bench::SweepPlan plan, std::map<std::size_t, bench::PointRecord> stored, SweepRunOptions options)
+    : supervisor_(supervisor),
+      bench_limits_(supervisor.limits()),
+      store_(store),
+      id_(id),
+      sparse_(plan.mode == bench::SweepMode::adaptive),
+      sink_(std::make_unique<Sink>(store, id, options.observer)) {
+  // A plan may only tighten what the bench allows, on the daemon as on the command line.
+  supervisor_.set_limits(bench::stricter(bench_limits_, bench::safety_limits(plan)));
+  engine_ = std::make_unique<bench::SweepEngine>(devices, supervisor_, std::move(plan), std::move(stored), *sink_,
+                                                 options.calibration);
+}
+
+SweepRun::~SweepRun() { supervisor_.set_limits(bench_limits_); }
+
+std::optional<std::string> SweepRun::begin() {
+  if (auto r = store_.set_sweep_state(id_, db::SweepState::running); !r) return r.error().message;
+  return std::nullopt;
+}
+
+db::SweepState SweepRun::final_state() const {
+  switch (engine_->state()) {
+    case bench::SweepState::completed: return db::SweepState::completed;
+    case bench::SweepState::aborted: return db::SweepState::aborted;
+    default: return db::SweepState::faulted;
+  }
+}
+
+std::optional<std::string> SweepRun::finish() {
+  std::optional<std::string> err;
+  if (!engine_->error().empty()) err = engine_->error();
+  if (auto r = store_.set_sweep_state(id_, final_state(), err, sparse_); !r) return r.error().message;
+  return std::nullopt;
+}
+
+}  // namespace synbench::app
