@@ -1,6 +1,6 @@
-// `synbench emulate`: the bench's twin as a Modbus device (TCP or RTU), in real or scaled time,
-// with the default profiles' register map, the firmware's watchdog and windows, and fault hooks
-// for tests.
+// `synbench emulate`: the bench's twin as a Modbus device (TCP, RTU, or both at once on the same
+// twin), in real or scaled time, with the default profiles' register map, the firmware's
+// watchdog and windows, and fault hooks for tests.
 #include <signal.h>
 
 #include <atomic>
@@ -21,7 +21,7 @@
 
 namespace synbench::cli {
 
-const char* const kEmulateHelp = R"(usage: synbench emulate (--tcp HOST:PORT | --rtu DEVICE) [options]
+const char* const kEmulateHelp = R"(usage: synbench emulate [--tcp HOST:PORT] [--rtu DEVICE] [options]
 
 Serves the bench's twin over Modbus as synbench's drive firmware would: the SynRM drive at unit
 id 1, the load drive at 2 and the VFC meter at 3, with the register maps of the default profiles
@@ -29,9 +29,10 @@ id 1, the load drive at 2 and the VFC meter at 3, with the register maps of the 
 heartbeat stops changing; the fault_reset coil clears it; window_start opens a measurement
 window (shared by the three devices, as one trigger line). Runs until SIGINT or SIGTERM.
 
-link (one of):
+links (at least one; given both, they serve the same twin: a bench on RTU, a test on TCP):
   --tcp HOST:PORT        Modbus TCP; port 0 picks a free port. Prints "listening on tcp HOST:PORT"
   --rtu DEVICE           Modbus RTU on a serial port or pseudo-terminal. Prints "listening on rtu DEVICE"
+                         (after the tcp line when both are given)
   --baud N               RTU baud rate (default 115200)
   --parity P             RTU parity: none (default), even, odd
 
@@ -47,7 +48,7 @@ twin:
                          counts X times over, so a scaled CI run may need a longer one
   --duration-s S         exit after S seconds of wall time
 
-fault hooks (for tests; docs/modbus.md):
+fault hooks (for tests; docs/modbus.md; with both links, on both, counted together):
   --fault-delay-pct P    percent of replies sent --fault-delay-ms late (past the master's timeout)
   --fault-delay-ms D     delay of a delayed reply, 1..60000 ms (default 1000)
   --fault-drop-pct P     percent of requests executed but never answered
@@ -55,13 +56,13 @@ fault hooks (for tests; docs/modbus.md):
   --fault-corrupt-pct P  percent of replies corrupted (RTU: bad CRC; TCP: wrong transaction id)
   --fault-stuck LIST     signals that freeze at their next read: UNIT:SIGNAL[,UNIT:SIGNAL...],
                          e.g. 1:speed_rpm,3:gate_sequence
-  --fault-cut-s S        on SIGUSR1, cut the link for S seconds (default 2)
+  --fault-cut-s S        on SIGUSR1, cut the link(s) for S seconds (default 2)
   --fault-seed N         seed of the fault draws (default 1)
   --help                 this text
 
 On exit prints the injected faults: "faults: requests N delayed N dropped N exceptions N
 corrupted N cuts N ignored_during_cut N".
-exit status: 0 stopped, 1 the link could not be opened, 2 bad input
+exit status: 0 stopped, 1 a link could not be opened, 2 bad input
 )";
 
 namespace {
@@ -133,7 +134,6 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
     const auto tcp = a.text("--tcp");
     const auto rtu = a.text("--rtu");
-    if (tcp && rtu) throw UsageError("--rtu", "give --tcp or --rtu, not both");
     if (!tcp && !rtu) throw UsageError("--tcp", "a link is required: --tcp HOST:PORT or --rtu DEVICE");
     if (tcp) parse_endpoint(*tcp, tcp_host, tcp_port);
     if (rtu) {
@@ -232,16 +232,17 @@ int emulate_command(const std::vector<std::string>& argv) {
   }
   if (watchdog_s)
     service.locked([&](auto&, emulator::TwinSignals& s, auto&) { s.set_watchdog_timeout_s(*watchdog_s); });
+  // One injector for both links: its draws and counts are shared (it locks), and a cut
+  // silences the device on every link, as a hung firmware would.
   emulator::FaultInjector injector(faults);
   emulator::ModbusTcpServer tcp_server(service, injector);
   emulator::ModbusRtuServer rtu_server(service, injector);
   std::string error;
-  if (serial.device.empty()) {
-    if (!tcp_server.start(tcp_host, tcp_port, error)) {
-      std::cerr << "synbench emulate: --tcp: " << error << "\n";
-      return 1;
-    }
-  } else if (!rtu_server.start(serial, error)) {
+  if (!tcp_host.empty() && !tcp_server.start(tcp_host, tcp_port, error)) {
+    std::cerr << "synbench emulate: --tcp: " << error << "\n";
+    return 1;
+  }
+  if (!serial.device.empty() && !rtu_server.start(serial, error)) {
     std::cerr << "synbench emulate: --rtu: " << error << "\n";
     return 1;
   }
@@ -256,11 +257,9 @@ int emulate_command(const std::vector<std::string>& argv) {
   ::signal(SIGPIPE, SIG_IGN);
 
   service.start_realtime(time_scale);
-  if (serial.device.empty()) {
+  if (!tcp_host.empty())
     std::cout << "listening on tcp " << tcp_host << ":" << tcp_server.port() << std::endl;
-  } else {
-    std::cout << "listening on rtu " << serial.device << std::endl;
-  }
+  if (!serial.device.empty()) std::cout << "listening on rtu " << serial.device << std::endl;
   const auto start = std::chrono::steady_clock::now();
   while (!g_stop) {
     if (g_cut.exchange(false)) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """`synbench emulate` as a user and a third-party master meet it: --help, bad input rejected with
 exit 2 naming the flag, mbpoll (Debian's Modbus master) reading documented telemetry and writing a
-setpoint over TCP and RTU, and `synbench point --bench` measuring one operating point over Modbus
+setpoint over TCP and RTU, and over both at once on one twin (a write on one link read back on the
+other, a cut silencing both), and `synbench point --bench` measuring one operating point over Modbus
 TCP and RTU (socat pseudo-terminals) with the same record as in-process, within the measurement
 noise. Exit 77 (skipped) where mbpoll or socat is missing."""
 import json
@@ -102,7 +103,7 @@ bad = [
     ([], "--tcp"),
     (["--tcp", "127.0.0.1"], "--tcp"),
     (["--tcp", "127.0.0.1:99999"], "--tcp"),
-    (["--tcp", "127.0.0.1:0", "--rtu", "/dev/null"], "--rtu"),
+    (["--rtu", ""], "--rtu"),
     (["--tcp", "127.0.0.1:0", "--baud", "9600"], "--baud"),
     (["--rtu", "/dev/null", "--baud", "12345"], "--baud"),
     (["--rtu", "/dev/null", "--parity", "mark"], "--parity"),
@@ -167,6 +168,26 @@ code, v = mbpoll("-m", "rtu", "-b", "115200", "-P", "none", "-a", "1", "-t", "3"
 check(code == 0 and v == {0: "0", 1: "0"}, f"mbpoll over RTU reads state and fault_code: {v}")
 code, v = mbpoll("-m", "rtu", "-b", "115200", "-P", "none", "-a", "1", "-t", "4", "-r", "19", pair.b, "1")
 check(code == 0, "mbpoll over RTU writes pwm_scheme = aspwm")
+emu.stop()
+
+# Both links at once on the same twin: a write over RTU is read back over TCP, and the other way.
+emu = Emulator("--rtu", pair.a, "--tcp", "127.0.0.1:0")
+rtu_banner = emu.p.stdout.readline().strip()
+check(emu.port is not None and rtu_banner == f"listening on rtu {pair.a}",
+      f"emulate --rtu --tcp prints both links: {emu.banner} / {rtu_banner}")
+rtu = ["-m", "rtu", "-b", "115200", "-P", "none"]
+code, _ = mbpoll(*rtu, "-a", "1", "-t", "4:float", "-B", "-r", "16", pair.b, "321")
+code2, v = mbpoll("-m", "tcp", "-p", str(emu.port), "-a", "1", "-t", "4:float", "-B", "-r", "16", "127.0.0.1")
+check(code == 0 and code2 == 0 and float(v.get(16, "nan")) == 321.0,
+      f"speed_setpoint_rpm written over RTU reads 321 over TCP: {v}")
+code, _ = mbpoll("-m", "tcp", "-p", str(emu.port), "-a", "1", "-t", "4", "-r", "19", "127.0.0.1", "1")
+code2, v = mbpoll(*rtu, "-a", "1", "-t", "4", "-r", "19", pair.b)
+check(code == 0 and code2 == 0 and v.get(19) == "1", f"pwm_scheme written over TCP reads 1 over RTU: {v}")
+emu.p.send_signal(signal.SIGUSR1)
+time.sleep(0.2)
+code, _ = mbpoll("-m", "tcp", "-p", str(emu.port), "-a", "1", "-t", "3", "-r", "0", "127.0.0.1")
+code2, _ = mbpoll(*rtu, "-a", "1", "-t", "3", "-r", "0", pair.b)
+check(code != 0 and code2 != 0, "SIGUSR1 cuts both links")
 emu.stop()
 pair.stop()
 

@@ -1,0 +1,318 @@
+#!/usr/bin/env python3
+"""`synbench serve --bench` on `synbench emulate`, judged from the far side: every check reads the
+drives' registers from the emulator over a Modbus TCP connection of its own (far_side.py), never
+the daemon's status. Once with the daemon on Modbus TCP, once on Modbus RTU (a socat pty pair at
+115200 baud; the emulator serves the same twin on TCP too, for the checks).
+
+The daemon answers a command once it has acted on it, so what a command does is read from the
+registers as soon as its reply arrives (the ordered stop and the spin-up excepted: they take
+time by design). For each link:
+ 1. enable over REST: both drives' state registers read running;
+ 2. setpoints over REST (600 rpm, 1 N m, 50 deg): the setpoint registers hold them, the
+    heartbeat registers change, the shaft turns at 600 rpm;
+ 3. disable (the ordered stop): both drives read disabled;
+ 4. a sweep started over REST: the drives run it;
+ 5. E-stop while it runs: both drives read disabled within 1 s of the request, stay disabled,
+    and the heartbeat registers stop changing (the heartbeats stop at once); when its reply
+    arrives, the drives already read disabled;
+ 6. the drives' own watchdog is the second line: the load drive, enabled behind the daemon's
+    back at zero torque, trips its watchdog (nothing sends heartbeats), or the daemon disables
+    it again;
+ 7. reset: 200, both drives' latched faults cleared (state disabled, fault_code none);
+ 8. enable again: the drives run, the shaft turns at the setpoint;
+ 9. SIGTERM: the daemon exits 0 and both drives read disabled, and stay so past the watchdog.
+
+The emulator's watchdog is 3 s here (--watchdog-timeout-ms 3000: a loaded CI machine can stall
+the daemon for a fraction of a second); the E-stop deadline, 1 s, stays well inside it, and a
+drive the watchdog stopped reads faulted, not disabled: a drive reading disabled within the
+deadline was disabled by the daemon.
+
+usage: serve_bench_test.py path/to/synbench [tcp|rtu ...]
+Exit 77 (skipped) without socat (scripts/debian-packages.txt), 1 on any failure. Standard
+library only: the Modbus master is far_side.py's, not mbpoll (a process per read is too slow to
+time an E-stop).
+"""
+import os
+import shutil
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import far_side as fs  # noqa: E402
+
+BIN = sys.argv[1]
+LINKS = sys.argv[2:] or ["tcp", "rtu"]
+WATCHDOG_MS = 3000
+ESTOP_DEADLINE_S = 1.0    # the issue's bound: request sent -> both drives read disabled
+STAY_S = 2.0              # and they stay disabled this long
+HEARTBEAT_SETTLE_S = 0.2  # a heartbeat already on the wire may still land
+SPEED, LOAD_NM, ANGLE = 600.0, 1.0, 50.0
+# Starting processes, spinning up, ordered stops: generous, for a loaded 2-core machine.
+SLOW_S = 30.0
+PLAN = {"name": "estop under a sweep", "window_s": 1.0,
+        "dimensions": {"speed_rpm": [SPEED], "load_Nm": [LOAD_NM], "angle_deg": [46, 50, 54, 58]}}
+failures = []
+
+if not shutil.which("socat"):
+    print("skip: socat is not installed (scripts/debian-packages.txt)")
+    sys.exit(77)
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+    return cond
+
+
+def note(what):
+    print("     " + what)
+
+
+def wait_for(pred, timeout_s, period_s=0.02):
+    """Polls pred() until it returns a true value (returned) or the time is up (the last value)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        v = pred()
+        if v or time.monotonic() > deadline:
+            return v
+        time.sleep(period_s)
+
+
+def both(state):
+    return lambda far: all(s == state for s, _ in far.states())
+
+
+def running_at(far, speed, tol):
+    (s1, _), (s2, _) = far.states()
+    return s1 == fs.RUNNING and s2 == fs.RUNNING and abs(far.speed_rpm() - speed) <= tol
+
+
+def spin_timeout(far):
+    """Spinning up takes seconds on a loaded machine; no need to wait when the drives are off."""
+    return SLOW_S if both(fs.RUNNING)(far) else 2.0
+
+
+def sweep_state(serve, sid):
+    status, body = serve.request("GET", "/api/sweeps/%s" % sid)
+    return body.get("state") if status == 200 and isinstance(body, dict) else "HTTP %s" % status
+
+
+def watch_estop(far, pending, deadline_s, stay_s):
+    """Polls the drives' state and heartbeat registers every 2 ms or so from the moment the
+    E-stop request was sent (no faster: the emulator also serves the daemon, and this is a test
+    of a 1 s bound, not a benchmark): when both first read disabled, what they read after that,
+    and the heartbeat values seen after the settling time; and what the first read started
+    after the daemon's reply saw."""
+    t_disabled = None
+    relapses = []
+    beats = set()
+    last = at_reply = None
+    while True:
+        answered = pending.poll()
+        states = far.states()
+        now = time.monotonic() - pending.sent_at
+        if answered and at_reply is None:
+            at_reply = states
+        last = states
+        off = all(s == fs.DISABLED for s, _ in states)
+        if t_disabled is None and off:
+            t_disabled = now
+        elif t_disabled is not None and not off and len(relapses) < 5:
+            relapses.append("%.3f s: %s" % (now, fs.describe(states)))
+        if now >= HEARTBEAT_SETTLE_S:
+            beats.add(far.heartbeats())
+        if t_disabled is None and now > deadline_s + 1.0:
+            break  # it will not come; the verdict is in
+        if t_disabled is not None and now > t_disabled + stay_s:
+            break
+        time.sleep(0.002)
+    pending.wait(10)
+    return t_disabled, relapses, beats, last, at_reply
+
+
+def run_link(kind, tmp):
+    print("--- daemon over Modbus %s" % kind.upper())
+    pair = fs.SocatPair(tmp, kind) if kind == "rtu" else None
+    emu = fs.Emulator(BIN, os.path.join(tmp, kind + "_emulate.log"), rtu=pair.a if pair else None,
+                      args=["--watchdog-timeout-ms", str(WATCHDOG_MS), "--duration-s", "900"])
+    far = fs.ModbusTcp(emu.port)
+    serve = None
+    try:
+        # The far side itself first: plausible values decode.
+        udc = far.udc_V()
+        check(400 <= udc <= 450, "%s: far side reads udc_V (SynRM input 30, 0.1 V): %.1f V" % (kind, udc))
+        check(far.states() == ((0, 0), (0, 0)), "%s: both drives disabled, no fault before the daemon starts: %s"
+              % (kind, fs.describe(far.states())))
+        link = fs.rtu_link(pair.b) if pair else fs.tcp_link(emu.port)
+        cfg = fs.write_bench_config(os.path.join(tmp, kind + "_bench.json"), link)
+        data_dir = os.path.join(tmp, kind + "_data")
+        serve = fs.Serve(BIN, cfg, data_dir, os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
+        status, devices = serve.request("GET", "/api/devices")
+        check(status == 200 and all(d.get("backend") == "modbus" for d in devices),
+              "%s: the daemon's devices are Modbus devices (%s)" % (kind, devices))
+
+        # 1. Enable.
+        status, body = serve.request("POST", "/api/bench/enable", {"enabled": True})
+        now = far.states()
+        check(status == 200, "%s: POST /api/bench/enable -> 200 (%s %s)" % (kind, status, str(body)[:200]))
+        check(all(s == fs.RUNNING for s, _ in now),
+              "%s: both drives read running when the reply arrives: %s" % (kind, fs.describe(now)))
+
+        # 2. Setpoints.
+        status, body = serve.request("POST", "/api/bench/setpoints",
+                                     {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
+        check(status == 200, "%s: POST /api/bench/setpoints -> 200 (%s %s)" % (kind, status, str(body)[:200]))
+        sp = (far.speed_setpoint_rpm(), far.angle_setpoint_deg(), far.torque_setpoint_Nm())
+        check(sp[0] == SPEED and abs(sp[1] - ANGLE) < 0.006 and sp[2] == LOAD_NM,
+              "%s: setpoint registers when the reply arrives: speed %.1f rpm (SynRM holding 16-17 f32), angle %.2f deg (holding 18 i16 "
+              "x0.01), torque %.2f N m (load holding 16-17 f32)" % (kind, sp[0], sp[1], sp[2]))
+        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        check(spun, "%s: the shaft turns at %.0f rpm (SynRM input 16-17 f32: %.1f rpm), %s"
+              % (kind, SPEED, far.speed_rpm(), fs.describe(far.states())))
+        hb0 = far.heartbeats()
+        time.sleep(0.5)
+        hb1 = far.heartbeats()
+        check(hb0[0] != hb1[0] and hb0[1] != hb1[1],
+              "%s: the daemon's heartbeats reach both drives (holding 0: %s -> %s in 0.5 s)" % (kind, hb0, hb1))
+
+        # 3. The ordered stop.
+        status, body = serve.request("POST", "/api/bench/enable", {"enabled": False})
+        check(status == 200, "%s: POST /api/bench/enable false -> 200 (%s)" % (kind, status))
+        ok = wait_for(lambda: both(fs.DISABLED)(far), SLOW_S, 0.05)
+        check(ok, "%s: the ordered stop ends with both drives disabled: %s, %.1f rpm"
+              % (kind, fs.describe(far.states()), far.speed_rpm()))
+
+        # 4. A sweep.
+        status, sweep = serve.request("POST", "/api/sweeps", PLAN)
+        check(status == 201, "%s: POST /api/sweeps -> 201 (%s %s)" % (kind, status, str(sweep)[:200]))
+        sid = sweep.get("id") if isinstance(sweep, dict) else None
+        status, body = serve.request("POST", "/api/sweeps/%s/start" % sid)
+        check(status == 202, "%s: POST /api/sweeps/%s/start -> 202 (%s %s)" % (kind, sid, status, str(body)[:200]))
+        spun = wait_for(lambda: running_at(far, SPEED, 0.5 * SPEED), SLOW_S, 0.05)
+        check(spun, "%s: the sweep runs the drives: %s, %.1f rpm" % (kind, fs.describe(far.states()), far.speed_rpm()))
+        state = sweep_state(serve, sid)
+        check(state == "running", "%s: the sweep is running when the E-stop comes (%s)" % (kind, state))
+
+        # 5. E-stop while it runs.
+        before = far.states()
+        hb_before = far.heartbeats()
+        pending = fs.PendingRequest(serve.port, serve.raw_request_bytes("POST", "/api/bench/estop"))
+        t_off, relapses, beats, last, at_reply = watch_estop(far, pending, ESTOP_DEADLINE_S, STAY_S)
+        reply_s = pending.answered_at - pending.sent_at if pending.answered_at else None
+        note("%s: before the E-stop %s; E-stop answered %s in %s" % (
+            kind, fs.describe(before), pending.status, "%.1f ms" % (1e3 * reply_s) if reply_s is not None else "-"))
+        check(pending.status == 200, "%s: POST /api/bench/estop -> 200 (%s %s)" % (kind, pending.status, (pending.body or b"")[:200]))
+        check(t_off is not None and t_off <= ESTOP_DEADLINE_S,
+              "%s: both drives read disabled within %.1f s of the E-stop request (%s; now %s)"
+              % (kind, ESTOP_DEADLINE_S, "%.1f ms" % (1e3 * t_off) if t_off is not None else "never", fs.describe(last)))
+        check(at_reply is not None and all(s == fs.DISABLED for s, _ in at_reply),
+              "%s: when the E-stop's reply arrives, both drives already read disabled (it replies once it "
+              "has acted): %s" % (kind, fs.describe(at_reply) if at_reply else "no reply"))
+        check(t_off is not None and not relapses,
+              "%s: and stay disabled for %.0f s (%s)" % (kind, STAY_S, "; ".join(relapses) or "no relapse"))
+        check(len(beats) == 1,
+              "%s: the heartbeat registers stop changing from %.1f s after the E-stop (before %s; after: %s)"
+              % (kind, HEARTBEAT_SETTLE_S, hb_before, sorted(beats)[:6]))
+        status, st = serve.request("GET", "/api/bench/status")
+        sup = st.get("supervisor", {}) if isinstance(st, dict) else {}
+        check(sup.get("phase") == "estopped" and sup.get("tripped"),
+              "%s: the daemon says estopped (%s)" % (kind, sup))
+        ended = wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
+        check(ended, "%s: the sweep stops running (%s)" % (kind, sweep_state(serve, sid)))
+
+        # 6. The drives' own watchdog, the second line: the load drive is enabled behind the
+        # daemon's back, at zero torque so it cannot turn the shaft. With no heartbeats flowing it
+        # must trip its watchdog (fault 6) within the timeout (bench time = wall time here).
+        if t_off is not None:
+            far.write_words(fs.LOAD, fs.TORQUE_SETPOINT, fs.f32_words(0.0))
+            far.write_coil(fs.LOAD, fs.ENABLE_COIL, True)
+            t0 = time.monotonic()
+            check(far.state(fs.LOAD)[0] == fs.RUNNING, "%s: the far side enables the load drive at 0 N m" % kind)
+            # (A watchdog trip passes through stopping, the torque ramped to zero, to faulted.)
+            wait_for(lambda: far.state(fs.LOAD)[0] in (fs.DISABLED, fs.FAULTED), WATCHDOG_MS / 1000 + 3, 0.01)
+            dt = time.monotonic() - t0
+            end = far.states()
+            tripped = end[1] == (fs.FAULTED, fs.WATCHDOG)
+            redisabled = end[1][0] == fs.DISABLED
+            check(tripped or redisabled,
+                  "%s: ... and it stops after %.2f s: %s (%s)" % (kind, dt, fs.describe(end),
+                                                              "its watchdog tripped: no heartbeats" if tripped else
+                                                              "the daemon disabled it" if redisabled else "still running"))
+            if tripped:
+                check(WATCHDOG_MS / 1000 - 0.1 <= dt, "%s: not before the watchdog's %d ms (%.2f s)" % (kind, WATCHDOG_MS, dt))
+            if not (tripped or redisabled):
+                try:
+                    far.write_coil(fs.LOAD, fs.ENABLE_COIL, False)
+                except fs.ModbusError as e:
+                    note("%s: disabling the load drive again: %s" % (kind, e))
+        else:
+            note("%s: the second line is not tried: the drives never stopped" % kind)
+        faults_before = far.states()
+
+        # 7. Reset.
+        status, body = serve.request("POST", "/api/bench/reset")
+        check(status == 200, "%s: POST /api/bench/reset -> 200 (%s %s)" % (kind, status, str(body)[:200]))
+        now = far.states()
+        check(now == ((fs.DISABLED, 0), (fs.DISABLED, 0)),
+              "%s: reset has cleared the drives' latched faults when its reply arrives (before: %s; after: %s)"
+              % (kind, fs.describe(faults_before), fs.describe(now)))
+
+        # 8. Enable again (from disabled: a drive that never stopped proves nothing here).
+        was_off = all(s == fs.DISABLED for s, _ in far.states())
+        status, body = serve.request("POST", "/api/bench/enable", {"enabled": True})
+        now = far.states()
+        check(status == 200, "%s: POST /api/bench/enable after the reset -> 200 (%s %s)" % (kind, status, str(body)[:200]))
+        check(was_off and all(s == fs.RUNNING for s, _ in now),
+              "%s: both drives, disabled before, read running when the reply arrives: %s" % (kind, fs.describe(now)))
+        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        check(was_off and spun and far.speed_setpoint_rpm() == SPEED,
+              "%s: the drives, disabled before, run again at %.0f rpm: %s, %.1f rpm, setpoint register %.1f%s"
+              % (kind, SPEED, fs.describe(far.states()), far.speed_rpm(), far.speed_setpoint_rpm(),
+                 "" if was_off else " (they were never disabled)"))
+
+        # 9. SIGTERM.
+        rc = serve.stop()
+        after = far.states()
+        check(rc == 0, "%s: SIGTERM -> the daemon exits 0 (%s)" % (kind, rc))
+        check(all(s == fs.DISABLED for s, _ in after), "%s: both drives read disabled when it has exited: %s"
+              % (kind, fs.describe(after)))
+        time.sleep(WATCHDOG_MS / 1000 + 0.5)
+        later = far.states()
+        check(later == ((0, 0), (0, 0)), "%s: and %.1f s later, past the watchdog: %s"
+              % (kind, WATCHDOG_MS / 1000 + 0.5, fs.describe(later)))
+    finally:
+        if serve is not None and serve.proc.poll() is None:
+            serve.kill()
+        far.close()
+        rc, out = emu.stop()
+        note("%s: emulator: %s" % (kind, " | ".join(out[-2:])))
+        if pair:
+            pair.stop()
+    if failures:
+        for name in ("serve", "emulate"):
+            log = os.path.join(tmp, "%s_%s.log" % (kind, name))
+            if os.path.exists(log):
+                tail = open(log).read().strip().splitlines()[-8:]
+                note("%s: last lines of %s's log:" % (kind, name))
+                for line in tail:
+                    note("  " + ("(a line with the token)" if "sbt_" in line else line))
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="synbench_serve_bench_")
+    try:
+        for kind in LINKS:
+            try:
+                run_link(kind, tmp)
+            except (RuntimeError, OSError, fs.ModbusError) as e:
+                check(False, "%s: %s" % (kind, e))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("all checks passed" if not failures else "%d checks FAILED" % len(failures))
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
