@@ -32,8 +32,10 @@ Exit 77 (skipped) without socat (scripts/debian-packages.txt), 1 on any failure.
 library only: the Modbus master is far_side.py's, not mbpoll (a process per read is too slow to
 time an E-stop).
 """
+import json
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import time
@@ -42,7 +44,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import far_side as fs  # noqa: E402
 
 BIN = sys.argv[1]
-LINKS = sys.argv[2:] or ["tcp", "rtu"]
+LINKS = sys.argv[2:] or ["tcp", "rtu", "cli"]
 WATCHDOG_MS = 3000
 ESTOP_DEADLINE_S = 1.0    # the issue's bound: request sent -> both drives read disabled
 STAY_S = 2.0              # and they stay disabled this long
@@ -300,12 +302,77 @@ def run_link(kind, tmp):
                     note("  " + ("(a line with the token)" if "sbt_" in line else line))
 
 
+def run(*args, timeout=180):
+    p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+def run_cli(tmp):
+    """The command line on the same drives, without the daemon: `bench status|reset`, `sweep
+    --bench` and `point --bench` under the supervisor, each judged from the far side."""
+    print("--- the command line over Modbus TCP")
+    emu = fs.Emulator(BIN, os.path.join(tmp, "cli_emulate.log"),
+                      args=["--watchdog-timeout-ms", str(WATCHDOG_MS), "--duration-s", "900"])
+    far = fs.ModbusTcp(emu.port)
+    try:
+        cfg = fs.write_bench_config(os.path.join(tmp, "cli_bench.json"), fs.tcp_link(emu.port))
+        code, out, err = run("bench", "status", "--bench", cfg, "--json")
+        doc = json.loads(out) if code == 0 else {}
+        check(code == 0 and doc.get("synrm", {}).get("state") == "disabled" and doc.get("load", {}).get("state") == "disabled",
+              "cli: bench status reads both drives disabled (%s %s)" % (code, out.strip() or err.strip()))
+
+        # A drive running behind everybody's back: reset is refused, and nothing is cleared.
+        far.write_coil(2, 0, True)
+        time.sleep(0.2)
+        code, out, err = run("bench", "reset", "--bench", cfg)
+        check(code == 1 and "running" in err, "cli: bench reset refused while a drive runs (%s: %s)" % (code, err.strip()))
+        # Its watchdog trips (nobody sends heartbeats): faulted, then reset clears it.
+        deadline = time.time() + WATCHDOG_MS / 1000 + SLOW_S
+        while time.time() < deadline and far.state(2)[0] != fs.FAULTED:
+            time.sleep(0.1)
+        check(far.state(2) == (fs.FAULTED, 6), "cli: the load drive's watchdog trips: %s" % fs.describe(far.states()))
+        code, out, err = run("bench", "reset", "--bench", cfg)
+        check(code == 0 and far.states() == ((0, 0), (0, 0)),
+              "cli: bench reset clears the latched watchdog fault, read over Modbus: %s (%s %s)"
+              % (fs.describe(far.states()), code, err.strip()))
+
+        # A short sweep on the drives, into SQLite; they end disabled.
+        plan = os.path.join(tmp, "cli_plan.json")
+        with open(plan, "w") as f:
+            json.dump({"name": "cli sweep", "dimensions": {"speed_rpm": [500], "load_Nm": [0.5], "angle_deg": [50, 54],
+                                                           "configurations": [{"estimator": "encoder", "pwm": "capwm"}]},
+                       "window_s": 0.5}, f)
+        db = os.path.join(tmp, "cli.db")
+        points = os.path.join(tmp, "cli_points.json")
+        code, out, err = run("sweep", plan, "--bench", cfg, "--db", db, "--quiet", "--export-json", points, timeout=300)
+        stored = json.load(open(points)) if os.path.exists(points) else []
+        check(code == 0 and len(stored) == 2 and all(abs(p["speed_meas_rpm"] - 500) < 25 for p in stored),
+              "cli: sweep --bench measures 2 points at 500 rpm on the drives (%s, %d points; %s)"
+              % (code, len(stored), err.strip()[-200:]))
+        check(far.states() == ((0, 0), (0, 0)), "cli: after the sweep both drives read disabled: %s" % fs.describe(far.states()))
+
+        # The bench config's limits bind `point`: 0.3 A trips overcurrent, and the drives are stopped.
+        strict = json.load(open(cfg))
+        strict["limits"] = {"max_current_A": 0.3}
+        strict_cfg = os.path.join(tmp, "cli_strict.json")
+        json.dump(strict, open(strict_cfg, "w"))
+        code, out, err = run("point", "--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--bench", strict_cfg)
+        check(code == 3 and "overcurrent" in err, "cli: point --bench trips on the config's 0.3 A limit (%s: %s)"
+              % (code, err.strip()[-200:]))
+        states = far.states()
+        check(all(s != fs.RUNNING for s, _ in states),
+              "cli: after the trip neither drive runs, read over Modbus: %s" % fs.describe(states))
+    finally:
+        far.close()
+        emu.stop()
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="synbench_serve_bench_")
     try:
         for kind in LINKS:
             try:
-                run_link(kind, tmp)
+                run_cli(tmp) if kind == "cli" else run_link(kind, tmp)
             except (RuntimeError, OSError, fs.ModbusError) as e:
                 check(False, "%s: %s" % (kind, e))
     finally:
