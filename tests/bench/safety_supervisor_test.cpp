@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/error.hpp"
 #include "emulator/twin_bench.hpp"
 
 namespace synbench::bench {
@@ -134,6 +135,173 @@ TEST(SafetySupervisor, EveryFaultClassEndsInALatchedOrderedStop) {
     std::printf("  %-28s stopped within %.2f s\n", name.c_str(), dt);
     EXPECT_LT(dt, 10.0) << name;  // the worst case is a coast-down from the firmware's 1800 rpm trip
   }
+}
+
+// The drives as the twin has them, every command logged with the bench time and the plant's
+// state when it was sent; the SynRM drive can be made to ignore its disable (a lost write, a
+// drive that does not obey).
+struct Recorded {
+  std::string what;
+  double value, t, shaft_rpm, load_Nm;
+};
+struct RecordingBench {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  std::vector<Recorded> log;
+  double t = 0;
+  bool ignore_synrm_disable = false;
+  int synrm_disables = 0;
+  void note(const char* what, double v) {
+    const auto snap = bench.twin().snapshot();
+    log.push_back({what, v, t, snap.speed_rpm, snap.load_torque_Nm});
+  }
+  struct Synrm final : drivers::SynrmDrive {
+    RecordingBench& r;
+    drivers::SynrmDrive& d;
+    Synrm(RecordingBench& rb, drivers::SynrmDrive& dd) : r(rb), d(dd) {}
+    std::error_code enable(bool on) override {
+      r.note("synrm.enable", on);
+      if (!on) ++r.synrm_disables;
+      if (!on && r.ignore_synrm_disable) return {};
+      return d.enable(on);
+    }
+    std::error_code set_speed_rpm(double v) override {
+      r.note("synrm.speed", v);
+      return d.set_speed_rpm(v);
+    }
+    std::error_code set_angle_deg(double v) override { return d.set_angle_deg(v); }
+    std::error_code set_pwm(drivers::Pwm p) override { return d.set_pwm(p); }
+    std::error_code set_estimator(drivers::Estimator e) override { return d.set_estimator(e); }
+    std::error_code reset_fault() override { return d.reset_fault(); }
+    std::error_code read(drivers::SynrmTelemetry& out) override { return d.read(out); }
+    std::error_code read_window(drivers::SynrmWindow& out) override { return d.read_window(out); }
+  } synrm{*this, *bench.devices().synrm};
+  struct Load final : drivers::LoadDrive {
+    RecordingBench& r;
+    drivers::LoadDrive& d;
+    Load(RecordingBench& rb, drivers::LoadDrive& dd) : r(rb), d(dd) {}
+    std::error_code enable(bool on) override {
+      r.note("load.enable", on);
+      return d.enable(on);
+    }
+    std::error_code set_torque_Nm(double v) override {
+      r.note("load.torque", v);
+      return d.set_torque_Nm(v);
+    }
+    std::error_code reset_fault() override { return d.reset_fault(); }
+    std::error_code read(drivers::LoadTelemetry& out) override { return d.read(out); }
+    std::error_code read_window(drivers::LoadWindow& out) override { return d.read_window(out); }
+  } load{*this, *bench.devices().load};
+  std::vector<std::pair<std::string, std::string>> events;
+  SafetySupervisor sup{devices(), SafetyLimits{},
+                       [this](const std::string& k, const std::string& m) { events.emplace_back(k, m); }};
+
+  drivers::BenchDevices devices() {
+    auto d = bench.devices();
+    d.synrm = &synrm;
+    d.load = &load;
+    return d;
+  }
+  void run_until(double end_s) {
+    while (t < end_s - 1e-9) {
+      t += 0.01;
+      bench.clock().wait_until(t);
+      sup.tick(t);
+    }
+  }
+  void start(double speed_rpm, double load_Nm) {
+    auto d = devices();
+    ASSERT_FALSE(d.load->enable(true));
+    ASSERT_FALSE(d.synrm->set_angle_deg(56));
+    ASSERT_FALSE(d.synrm->set_speed_rpm(speed_rpm));
+    ASSERT_FALSE(d.synrm->enable(true));
+    run_until(1.5);
+    ASSERT_FALSE(d.load->set_torque_Nm(load_Nm));
+    run_until(3.0);
+    ASSERT_FALSE(sup.tripped());
+    log.clear();
+  }
+  const Recorded* first(const std::string& what, double value) const {
+    for (const auto& r : log)
+      if (r.what == what && r.value == value) return &r;
+    return nullptr;
+  }
+};
+
+// After a trip the supervisor takes the load torque off first, commands zero speed only once the
+// load has let go, and disables both drives only once the shaft has stopped: its phases follow.
+TEST(SafetySupervisor, TheOrderedStopTakesTheLoadThenTheSpeedThenDisables) {
+  RecordingBench r;
+  r.start(700, 2.5);
+  // Hotter than the supervisor's 110 degC, cooler than the firmware's own 120: the drives keep
+  // control and the stop is the supervisor's.
+  r.bench.twin().set_winding_temp_C(112.0);
+  std::vector<SafetyPhase> phases;
+  for (int i = 0; i < 1500 && r.sup.phase() != SafetyPhase::stopped; ++i) {
+    r.run_until(r.t + 0.01);
+    if (r.sup.tripped() && (phases.empty() || phases.back() != r.sup.phase())) phases.push_back(r.sup.phase());
+  }
+  ASSERT_TRUE(r.sup.trip());
+  EXPECT_EQ(r.sup.trip()->fault, drivers::Fault::overtemperature);
+  const std::vector<SafetyPhase> expected = {SafetyPhase::stopping_load, SafetyPhase::stopping_speed, SafetyPhase::stopped};
+  EXPECT_EQ(phases, expected);
+  ASSERT_FALSE(r.log.empty());
+  EXPECT_EQ(r.log.front().what, "load.torque") << "the first command after the trip";
+  EXPECT_EQ(r.log.front().value, 0.0);
+  const auto* speed0 = r.first("synrm.speed", 0.0);
+  const auto* off_s = r.first("synrm.enable", 0.0);
+  const auto* off_l = r.first("load.enable", 0.0);
+  ASSERT_TRUE(speed0 && off_s && off_l);
+  EXPECT_LT(std::fabs(speed0->load_Nm), 0.05) << "zero speed only once the load has let go";
+  EXPECT_GT(speed0->shaft_rpm, 500) << "the shaft still turned when the load had gone";
+  EXPECT_GT(off_s->t, speed0->t);
+  // The drive's speed telemetry is filtered: the plant is a little behind the 20 rpm it saw.
+  EXPECT_LT(std::fabs(off_s->shaft_rpm), 40.0) << "disabled once the shaft stopped";
+  EXPECT_GE(off_l->t, speed0->t);
+  r.run_until(r.t + 0.5);
+  EXPECT_FALSE(r.sup.alarm()) << "both drives read back stopped";
+  EXPECT_FALSE(r.sup.confirming_stop());
+}
+
+// A drive that does not obey its disable (or whose disable was lost) is not taken for stopped:
+// the disable is repeated every tick, the alarm latches after stop_confirm_s, and no reset hides
+// it while the drive still runs. Once the drive obeys, the reset clears the alarm.
+TEST(SafetySupervisor, ADriveThatIgnoresItsDisableRaisesTheAlarm) {
+  RecordingBench r;
+  r.start(500, 1.0);
+  r.ignore_synrm_disable = true;
+  r.sup.estop(r.t, "test");
+  r.run_until(r.t + 0.2);
+  EXPECT_FALSE(r.sup.alarm()) << "within stop_confirm_s";
+  r.run_until(r.t + 0.2);
+  ASSERT_TRUE(r.sup.alarm());
+  EXPECT_NE(r.sup.alarm()->detail.find("SynRM drive still reports running"), std::string::npos) << r.sup.alarm()->detail;
+  EXPECT_EQ(r.sup.alarm()->detail.find("load drive"), std::string::npos) << "the load obeyed";
+  EXPECT_GE(r.synrm_disables, 30) << "the disable is repeated every tick";
+  bool alarm_event = false;
+  for (const auto& [k, m] : r.events) alarm_event = alarm_event || (k == "alarm" && m.find("ALARM") == 0);
+  EXPECT_TRUE(alarm_event);
+  EXPECT_EQ(r.sup.reset(), make_error_code(errc::busy));
+  EXPECT_TRUE(r.sup.tripped());
+  r.ignore_synrm_disable = false;
+  r.run_until(r.t + 0.05);
+  EXPECT_FALSE(r.sup.confirming_stop());
+  EXPECT_FALSE(r.sup.reset());
+  EXPECT_FALSE(r.sup.alarm());
+  EXPECT_FALSE(r.sup.tripped());
+}
+
+// A plan tightens the bench's limits, each bound on its own; it never loosens them.
+TEST(SafetySupervisor, StricterTakesEachBoundOnItsOwn) {
+  SafetyLimits bench_l, plan_l;
+  bench_l.max_current_A = 4.0;
+  plan_l.max_current_A = 0.5;
+  plan_l.max_speed_rpm = 2000;
+  plan_l.min_udc_V = 350;
+  const SafetyLimits s = stricter(bench_l, plan_l);
+  EXPECT_EQ(s.max_current_A, 0.5);
+  EXPECT_EQ(s.max_speed_rpm, bench_l.max_speed_rpm);
+  EXPECT_EQ(s.min_udc_V, 350);
+  EXPECT_EQ(s.max_udc_V, bench_l.max_udc_V);
 }
 
 }  // namespace
