@@ -24,8 +24,9 @@ class BenchBackend {
   virtual void tick(double /*now_s*/) {}
   // Stops or resumes the heartbeats. An E-stop stops them, so that a drive the disable did not
   // reach is stopped by its own watchdog; they resume on a reset.
-  virtual void set_heartbeats(bool /*on*/) {}
-  virtual bool heartbeats() const { return true; }
+  // (A bench without a watchdog, the in-process twin, only keeps the flag.)
+  virtual void set_heartbeats(bool on) { heartbeats_ = on; }
+  virtual bool heartbeats() const { return heartbeats_; }
   // The devices as GET /api/devices shows them: [{"role", "kind", "backend", "link", "profile"}].
   virtual nlohmann::json describe() const = 0;
   virtual const BenchDescription& description() const = 0;
@@ -33,6 +34,9 @@ class BenchBackend {
   virtual std::string links() const { return "twin (in-process)"; }
   // The last error of each link that had one, one per line ("" for the in-process twin).
   virtual std::string link_errors() const { return {}; }
+
+ private:
+  bool heartbeats_ = true;
 };
 
 }  // namespace synbench::app

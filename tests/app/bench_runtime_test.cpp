@@ -1,0 +1,150 @@
+// The bench runtime on the twin, in real time: commands are acted on by the bench thread in
+// order, an E-stop goes ahead of every command queued before it, every command is answered (also
+// at the shutdown), and a plan's stricter limits bind a sweep the daemon runs.
+#include "app/bench_runtime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <future>
+#include <thread>
+#include <vector>
+
+#include "bench/sweep_plan.hpp"
+#include "emulator/twin_bench.hpp"
+
+namespace synbench::app {
+namespace {
+
+class TwinBackend final : public BenchBackend {
+ public:
+  TwinBackend() : twin_(emulator::TwinConfig{}) {}
+  drivers::BenchDevices devices() override { return twin_.devices(); }
+  drivers::Clock& clock() override { return twin_.clock(); }
+  nlohmann::json describe() const override { return nlohmann::json::array(); }
+  const BenchDescription& description() const override { return description_; }
+
+ private:
+  emulator::TwinBench twin_;
+  BenchDescription description_;
+};
+
+// Collects outcomes in the order the bench thread gives them.
+struct Answers {
+  std::mutex m;
+  std::vector<std::pair<std::string, Outcome>> got;
+  BenchRuntime::Done done(std::string what) {
+    return [this, what](Outcome o) {
+      std::lock_guard lock(m);
+      got.emplace_back(what, std::move(o));
+    };
+  }
+  std::size_t size() {
+    std::lock_guard lock(m);
+    return got.size();
+  }
+};
+
+bool wait_for(const std::function<bool()>& cond, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (cond()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return cond();
+}
+
+TEST(BenchRuntime, AnEstopGoesAheadOfEveryCommandQueuedBeforeIt) {
+  BenchRuntime rt(std::make_unique<TwinBackend>());
+  Answers a;
+  // Queued before the bench thread runs, so the order the thread acts in is the test's to see.
+  for (int i = 0; i < 5; ++i) rt.set_setpoints({100.0 + i, std::nullopt, std::nullopt}, a.done("setpoints"));
+  rt.estop("test", a.done("estop"));
+  rt.start();
+  ASSERT_TRUE(wait_for([&] { return a.size() == 6; }, 5.0));
+  EXPECT_EQ(a.got.front().first, "estop");
+  EXPECT_FALSE(a.got.front().second.refusal);
+  ASSERT_TRUE(a.got.front().second.snapshot);
+  EXPECT_EQ(a.got.front().second.snapshot->status.phase, bench::SafetyPhase::estopped);
+  EXPECT_FALSE(a.got.front().second.snapshot->status.heartbeats);
+  for (std::size_t i = 1; i < a.got.size(); ++i) {
+    ASSERT_TRUE(a.got[i].second.refusal) << i;
+    EXPECT_EQ(a.got[i].second.refusal->code, Refused::tripped) << "acted on after the E-stop";
+  }
+  // The setpoints never reached the bench.
+  EXPECT_EQ(rt.snapshot()->status.setpoints.speed_rpm, 0.0);
+  Answers r;
+  rt.reset(r.done("reset"));
+  ASSERT_TRUE(wait_for([&] { return r.size() == 1; }, 5.0));
+  EXPECT_FALSE(r.got[0].second.refusal);
+  EXPECT_TRUE(r.got[0].second.snapshot->status.heartbeats);
+  EXPECT_FALSE(r.got[0].second.snapshot->status.trip);
+}
+
+TEST(BenchRuntime, ACommandIsAnsweredAfterTheBenchActedAndEveryOneAtTheShutdown) {
+  BenchRuntime rt(std::make_unique<TwinBackend>());
+  rt.start();
+  Answers a;
+  rt.set_setpoints({300.0, 0.0, 50.0}, a.done("setpoints"));
+  rt.enable(true, a.done("enable"));
+  ASSERT_TRUE(wait_for([&] { return a.size() == 2; }, 5.0));
+  ASSERT_FALSE(a.got[1].second.refusal);
+  // The snapshot in the answer is taken after the drives were read back.
+  ASSERT_TRUE(a.got[1].second.snapshot->status.synrm);
+  EXPECT_TRUE(drivers::running(a.got[1].second.snapshot->status.synrm->state));
+  rt.shutdown();
+  Answers late;
+  rt.enable(true, late.done("enable"));
+  rt.estop("late", late.done("estop"));
+  ASSERT_EQ(late.size(), 2u);
+  EXPECT_EQ(late.got[0].second.refusal->code, Refused::shutting_down);
+  EXPECT_EQ(late.got[1].second.refusal->code, Refused::shutting_down);
+  const auto& s = rt.snapshot()->status;
+  ASSERT_TRUE(s.synrm);
+  EXPECT_FALSE(drivers::running(s.synrm->state)) << "the shutdown ends with the drives read back disabled";
+  EXPECT_FALSE(s.alarm);
+}
+
+// A plan's limits bind the daemon's sweep as they bind `synbench sweep`: 0.5 A trips a point
+// that needs more, and the bench's own limits come back afterwards.
+TEST(BenchRuntime, APlansStricterLimitsBindTheDaemonsSweep) {
+  const auto dir = std::filesystem::temp_directory_path() / ("synbench_app_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto db_path = dir / "sweeps.db";
+  std::int64_t id = 0;
+  bench::SweepPlan plan;
+  {
+    auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(R"({"name": "strict", "window_s": 0.2,
+        "dimensions": {"speed_rpm": [300], "load_Nm": [1.5], "angle_deg": [50]}, "limits": {"max_current_A": 0.5}})"));
+    ASSERT_TRUE(parsed.plan) << (parsed.errors.empty() ? "" : parsed.errors[0].reason);
+    plan = *parsed.plan;
+    auto store = db::Store::open(db_path);
+    ASSERT_TRUE(store);
+    db::SweepMeta meta;
+    meta.name = "strict";
+    meta.plan = bench::to_json(plan);
+    meta.total_points = 1;
+    auto created = store->create_sweep(meta);
+    ASSERT_TRUE(created);
+    id = *created;
+  }
+  BenchRuntime rt(std::make_unique<TwinBackend>());
+  const double bench_limit_A = rt.description().limits.max_current_A;
+  rt.start();
+  Answers a;
+  rt.start_sweep(id, plan, {}, db_path, a.done("start"));
+  ASSERT_TRUE(wait_for([&] { return a.size() == 1; }, 5.0));
+  ASSERT_FALSE(a.got[0].second.refusal) << a.got[0].second.refusal->message;
+  ASSERT_TRUE(wait_for([&] { auto s = rt.snapshot(); return s->status.sweep && s->status.sweep->state == "faulted"; }, 30.0));
+  const auto s = rt.snapshot()->status;
+  ASSERT_TRUE(s.trip);
+  EXPECT_EQ(s.trip->fault, drivers::Fault::overcurrent) << s.trip->detail;
+  EXPECT_NE(s.trip->detail.find("0.50 A"), std::string::npos) << s.trip->detail;
+  EXPECT_GT(bench_limit_A, 1.0) << "the bench alone would have let the point run";
+  rt.shutdown();
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace synbench::app
