@@ -103,8 +103,16 @@ function renderBenchPills(st) {
   b.textContent = text;
   document.body.dataset.bench = state;
   const trip = st.supervisor?.trip;
+  const alarm = st.supervisor?.alarm;
   const driveFault = [st.synrm?.fault, st.load?.fault].find((x) => x && x !== 'none');
-  if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${trip.fault}`; f.title = trip.detail || ''; }
+  // A stop that did not take: as loud as the page can be, until a reset finds the drives stopped.
+  const banner = $('#alarm-banner');
+  banner.hidden = !alarm;
+  banner.textContent = alarm ? `ALARM: ${alarm.detail}. The drives' own watchdogs are the second line `
+    + `(heartbeats ${st.heartbeats === false ? 'stopped' : 'still sent'}): check the bench before anything else.` : '';
+  document.body.classList.toggle('alarm', !!alarm);
+  if (alarm) { f.dataset.state = 'tripped'; f.textContent = 'ALARM: drive not stopped'; f.title = alarm.detail; }
+  else if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${trip.fault}`; f.title = trip.detail || ''; }
   else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
   else if (st.synrm?.lock_lost) {
     f.dataset.state = 'warn'; f.textContent = 'lock lost: on the encoder';

@@ -175,6 +175,8 @@ export class LiveView {
     ];
     if (st.mode || st.estimator) rows.push(['estimator', `${st.mode?.estimator || st.estimator} / ${st.mode?.pwm || st.pwm || ''}`]);
     if (st.supervisor?.trip) rows.push(['trip', `${st.supervisor.trip.fault}: ${st.supervisor.trip.detail}`]);
+    if (st.supervisor?.alarm) rows.push(['ALARM', st.supervisor.alarm.detail]);
+    if (st.heartbeats === false) rows.push(['heartbeats', "stopped until reset: the drives' watchdogs are armed"]);
     const html = rows.map(([k, val]) => `<dt>${k}</dt><dd data-k="${k}">${escapeHtml(String(val))}</dd>`).join('');
     if (html !== this.readoutHtml) { this.readoutHtml = html; $('#readout').innerHTML = html; }
   }
