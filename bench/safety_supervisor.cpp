@@ -88,9 +88,10 @@ void SafetySupervisor::confirm_stop(double now_s) {
     confirm_deadline_s_.reset();
     return;
   }
-  // A disable lost on the link, or a drive that ignored it: say it again every tick.
-  if (synrm_ && drivers::running(synrm_->state)) dev_.synrm->enable(false);
-  if (load_ && drivers::running(load_->state)) dev_.load->enable(false);
+  // A disable lost on the link, or a drive that ignored it: say it again every tick, also to a
+  // drive that cannot be read (a disable is harmless to repeat, and a flaky line may carry it).
+  if (!synrm_ || drivers::running(synrm_->state)) dev_.synrm->enable(false);
+  if (!load_ || drivers::running(load_->state)) dev_.load->enable(false);
   if (alarm_ || now_s < *confirm_deadline_s_) return;
   char when[48];
   std::snprintf(when, sizeof when, " %.2f s after the disable", now_s - (*confirm_deadline_s_ - lim_.stop_confirm_s));

@@ -23,6 +23,9 @@ daemon returned, saved to a file; printed side by side with their ratio.
 
 usage: estop_latency_bench.py path/to/synbench [--trials 50] [--links tcp,rtu]
          [--conditions idle,sweep,polled] [--connections 50] [--threads 2] [--seconds 10] [--smoke]
+         [--before path/to/other/synbench]
+  --before: also measure the status throughput of another build's daemon (its own emulator), in
+  the same run: e.g. the build before the status snapshot.
   --smoke: 3 trials per link and condition, wrk 1 s with 4 connections; checks that every trial
   ends with both drives disabled and that both servers answer (no latency target is asserted).
 Exit 77 without wrk, nginx or socat; 1 when a trial or a server failed (the figures are then not
@@ -268,24 +271,40 @@ http {{
                 self.proc.wait()
 
 
-def status_vs_nginx(bench, tmp, connections, threads, seconds):
+def status_vs_nginx(bench, tmp, connections, threads, seconds, before=None):
     raw = LOCAL.open(urllib.request.Request(
         "http://%s/api/bench/status" % bench.serve.host,
         headers={"Authorization": "Bearer " + bench.viewer}), timeout=10).read()
     nginx = Nginx(tmp, raw)
+    old = None
     try:
         ours = run_wrk("http://%s/api/bench/status" % bench.serve.host, bench.viewer, connections, threads, seconds)
         theirs = run_wrk(nginx.url, bench.viewer, connections, threads, seconds)
+        if before:
+            # Another build's daemon (e.g. the commit before the snapshot) on an emulator of its own,
+            # measured in the same run, under the same load.
+            old = Bench(before, "tcp_before", tmp)
+            prior = run_wrk("http://%s/api/bench/status" % old.serve.host, old.viewer, connections, threads, seconds)
     finally:
         nginx.stop()
+        if old:
+            old.close()
     print()
     print("GET /api/bench/status under wrk: %d connections, %d threads, %d s, a %d-byte body (the daemon on the "
           "Modbus TCP bench after its trials)" % (connections, threads, seconds, len(raw)))
     print("  %-22s %10s %9s %9s %9s" % ("server", "req/s", "p50", "p90", "p99"))
-    for name, r in (("synbench serve", ours), ("nginx %s, 1 worker" % nginx.version, theirs)):
+    servers = [("synbench serve", ours), ("nginx %s, 1 worker" % nginx.version, theirs)]
+    if before:
+        servers.insert(0, ("before: " + os.path.basename(os.path.dirname(os.path.dirname(os.path.dirname(
+            os.path.abspath(before))))), prior))
+    for name, r in servers:
         print("  %-22s %10.0f %9s %9s %9s%s" % (name, r["rps"], r["pct"].get("50"), r["pct"].get("90"),
                                                r["pct"].get("99"), "  " + r["errors"] if r["errors"] else ""))
     print("  ratio synbench / nginx: %.2f" % (ours["rps"] / theirs["rps"] if theirs["rps"] else float("nan")))
+    if before:
+        print("  ratio before / nginx: %.2f; after / before: %.2f"
+              % (prior["rps"] / theirs["rps"] if theirs["rps"] else float("nan"),
+                 ours["rps"] / prior["rps"] if prior["rps"] else float("nan")))
     ok = True
     for name, r in (("synbench", ours), ("nginx", theirs)):
         if r["non2xx"] or r["rps"] <= 0:
@@ -337,7 +356,7 @@ def main():
                     print_row(rows[-1])
                 if kind == "tcp":
                     try:
-                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds) and ok
+                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds, arg("--before", "")) and ok
                     except (RuntimeError, OSError, subprocess.CalledProcessError) as e:
                         print("FAIL: status vs nginx: %s" % e)
                         ok = False
