@@ -162,11 +162,12 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
   Parser p;
   BenchConfig c;
   if (!p.object(doc, "")) return {std::nullopt, p.errors};
-  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "links", "devices"});
+  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "retry_budget_ms", "links", "devices"});
   if (auto v = p.number(doc, "", "time_scale", 0.001, 1000)) c.time_scale = *v;
   if (auto v = p.number(doc, "", "poll_period_ms", 1, 10000)) c.poll_period_ms = *v;
   if (auto v = p.number(doc, "", "window_margin_s", 0, 3600)) c.window_margin_s = *v;
-  if (auto v = p.number(doc, "", "retries", 0, 5, true)) c.retries = static_cast<int>(*v);
+  if (auto v = p.number(doc, "", "retries", 0, 10, true)) c.retries = static_cast<int>(*v);
+  if (auto v = p.number(doc, "", "retry_budget_ms", 0, 60000, false)) c.retry_budget_ms = *v;
 
   const auto links = doc.find("links");
   if (links == doc.end()) {
