@@ -19,7 +19,7 @@ std::string format(const char* fmt, double a, double b) {
 
 SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits,
                                    EventSink sink)
-    : dev_(devices), lim_(limits), sink_(std::move(sink)) {}
+    : dev_(devices), lim_(limits), sink_(std::move(sink)), plausibility_(limits.plausibility) {}
 
 void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string detail) {
   if (trip_) return;  // the first cause is the one that counts
@@ -58,6 +58,7 @@ std::error_code SafetySupervisor::reset() {
   if (trip_ && sink_) sink_("state", "reset after " + std::string(drivers::fault_name(trip_->fault)));
   trip_.reset();
   stop_duration_s_.reset();
+  plausibility_.reset();
   phase_ = SafetyPhase::normal;
   return {};
 }
@@ -100,6 +101,9 @@ void SafetySupervisor::tick(double now_s) {
   }
   if (load_ && !trip_ && load_->fault != drivers::Fault::none)
     raise(now_s, drivers::Fault::load_drive, "load drive reports " + std::string(drivers::fault_name(load_->fault)));
+  if (synrm_ && !trip_)
+    if (const auto bad = plausibility_.check(now_s, *synrm_))
+      raise(now_s, drivers::Fault::implausible_telemetry, "SynRM drive " + bad->describe());
 
   advance_stop(now_s);
 }

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "bench/ordered_stop.hpp"
+#include "bench/telemetry_plausibility.hpp"
 #include "drivers/devices.hpp"
 
 namespace synbench::bench {
@@ -24,6 +25,7 @@ struct SafetyLimits {
   double stop_load_timeout_s = 1.0;   // step one of the ordered stop; then the load is disabled
   double stop_speed_timeout_s = 10.0; // step two, then disable regardless
   double stopped_speed_rpm = 20.0;
+  PlausibilityLimits plausibility;  // implausible_telemetry (telemetry_plausibility.hpp)
 };
 
 // Why the bench stopped; `fault` names it with the device fault vocabulary.
@@ -76,6 +78,7 @@ class SafetySupervisor {
   OrderedStop stop_;
   std::optional<SafetyTrip> trip_;
   std::optional<double> stop_duration_s_;
+  TelemetryPlausibility plausibility_;
 };
 
 }  // namespace synbench::bench
