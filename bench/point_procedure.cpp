@@ -3,13 +3,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "bench/window_plausibility.hpp"
 #include "drivers/error.hpp"
 
 namespace synbench::bench {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// Failures of the link, not of the request: the same read may succeed on the next tick.
+bool link_error(std::error_code ec) {
+  return ec == errc::timeout || ec == errc::protocol || ec == errc::exception_reply || ec == errc::disconnected;
+}
 
 }  // namespace
 
@@ -31,9 +38,29 @@ bool PointProcedure::check(std::error_code ec, const char* what) {
   return false;
 }
 
+bool PointProcedure::tolerate(std::error_code ec, const char* what, double now_s, double since_s) {
+  if (link_error(ec) && now_s - since_s <= opt_.telemetry_timeout_s) {
+    ++tolerated_reads_;
+    return true;
+  }
+  char buf[96];
+  std::snprintf(buf, sizeof buf, " (nothing read for %.2f s)", now_s - since_s);
+  check(ec, what);
+  if (link_error(ec)) error_ += buf;
+  return false;
+}
+
+bool PointProcedure::command(std::error_code ec, const char* what, double now_s, double& failing_since_s) {
+  if (!ec) return true;
+  if (failing_since_s < 0) failing_since_s = now_s;
+  tolerate(ec, what, now_s, failing_since_s);
+  return false;
+}
+
 void PointProcedure::enter(PointPhase p, double now_s) {
   phase_ = p;
   t_phase_ = now_s;
+  t_step_failing_ = -1;
 }
 
 void PointProcedure::begin_stop(double now_s, bool ramped) {
@@ -53,7 +80,8 @@ void PointProcedure::begin_stop(double now_s, bool ramped) {
 }
 
 void PointProcedure::open_window(double now_s) {
-  if (!check(dev_.trigger->open_window(req_.window_s), "opening the measurement window")) return;
+  if (!command(dev_.trigger->open_window(req_.window_s), "opening the measurement window", now_s, t_step_failing_))
+    return;
   t_window_ = now_s;
   record_.settle_s = now_s - t_start_;
   enter(PointPhase::measure, now_s);
@@ -69,17 +97,32 @@ bool PointProcedure::ramp_load(double now_s) {
   t_last_tick_ = now_s;
   if (!load_pending_) return true;
   const double cmd = load_ramp_.step(dt);
+  // Pending until written: a write lost on the link is made again next tick (the ramp has moved
+  // on meanwhile, at its rate).
+  if (!command(dev_.load->set_torque_Nm(cmd), "setting load torque", now_s, t_ramp_failing_)) return false;
+  t_ramp_failing_ = -1;
   load_pending_ = !load_ramp_.done();
-  return check(dev_.load->set_torque_Nm(cmd), "setting load torque");
+  return true;
 }
 
 void PointProcedure::tick(double now_s) {
   if (finished()) return;
   drivers::SynrmTelemetry st;
   drivers::LoadTelemetry lt;
+  if (t_last_read_ < 0) t_last_read_ = now_s;
   if (phase_ != PointPhase::start) {
-    if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
-    if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
+    std::error_code ec = dev_.synrm->read(st);
+    const char* what = "reading SynRM drive telemetry";
+    if (!ec) {
+      ec = dev_.load->read(lt);
+      what = "reading load drive telemetry";
+    }
+    // A lost read skips the tick: nothing is decided on telemetry that did not arrive.
+    if (ec) {
+      tolerate(ec, what, now_s, t_last_read_);
+      return;
+    }
+    t_last_read_ = now_s;
     const auto fault = st.fault != drivers::Fault::none ? st.fault : lt.fault;
     const bool ramping_off = phase_ == PointPhase::stop && stop_ramped_ && stop_.step() == StopStep::load;
     if (fault != drivers::Fault::none && (phase_ != PointPhase::stop || ramping_off)) {
@@ -99,10 +142,15 @@ void PointProcedure::tick(double now_s) {
     if (st.lock_lost && lock_seen_ && phase_ != PointPhase::stop) record_.lock_lost = true;
   }
 
+  const auto step = [&](std::error_code ec, const char* what) { return command(ec, what, now_s, t_step_failing_); };
   switch (phase_) {
     case PointPhase::start: {
       t_start_ = now_s;
-      if (!check(dev_.synrm->read(st), "reading SynRM drive telemetry")) return;
+      if (const auto ec = dev_.synrm->read(st)) {
+        tolerate(ec, "reading SynRM drive telemetry", now_s, t_last_read_);
+        return;
+      }
+      t_last_read_ = now_s;
       if (st.fault != drivers::Fault::none) {
         error_ = "SynRM drive has a latched fault (" + std::string(drivers::fault_name(st.fault)) +
                  "); reset it first";
@@ -112,29 +160,32 @@ void PointProcedure::tick(double now_s) {
       if (opt_.continue_running && st.state == drivers::DriveState::running) {
         // Retarget a running bench: everything at once (the load at its ramp, from the setpoint
         // in force), then let the gate judge.
-        if (!check(dev_.load->read(lt), "reading load drive telemetry")) return;
-        if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
-        if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
-        if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
-        if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
+        if (const auto ec = dev_.load->read(lt)) {
+          tolerate(ec, "reading load drive telemetry", now_s, t_last_read_);
+          return;
+        }
+        if (!step(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
+        if (!step(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
+        if (!step(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+        if (!step(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
         load_ramp_.start(lt.torque_Nm, lt.torque_Nm);
         command_load(req_.load_Nm);
         t_last_tick_ = now_s;
         enter(PointPhase::load_up, now_s);
         return;
       }
-      if (!check(dev_.load->set_torque_Nm(0.0), "setting load torque")) return;
-      if (!check(dev_.load->enable(true), "enabling the load drive")) return;
-      if (!check(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
-      if (!check(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
+      if (!step(dev_.load->set_torque_Nm(0.0), "setting load torque")) return;
+      if (!step(dev_.load->enable(true), "enabling the load drive")) return;
+      if (!step(dev_.synrm->set_pwm(req_.pwm), "selecting the PWM scheme")) return;
+      if (!step(dev_.synrm->set_estimator(req_.estimator), "selecting the estimator")) return;
       sensorless_start_ = req_.estimator != drivers::Estimator::encoder;
       angle_pending_ = sensorless_start_ && opt_.sensorless_start_angle_deg > 0 &&
                        req_.angle_deg > opt_.sensorless_start_angle_deg;
-      if (!check(dev_.synrm->set_angle_deg(angle_pending_ ? opt_.sensorless_start_angle_deg : req_.angle_deg),
-                 "setting the current angle"))
+      const double start_angle = angle_pending_ ? opt_.sensorless_start_angle_deg : req_.angle_deg;
+      if (!step(dev_.synrm->set_angle_deg(start_angle), "setting the current angle"))
         return;
-      if (!check(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
-      if (!check(dev_.synrm->enable(true), "enabling the SynRM drive")) return;
+      if (!step(dev_.synrm->set_speed_rpm(req_.speed_rpm), "setting the speed")) return;
+      if (!step(dev_.synrm->enable(true), "enabling the SynRM drive")) return;
       enter(PointPhase::spin_up, now_s);
       return;
     }
@@ -158,7 +209,7 @@ void PointProcedure::tick(double now_s) {
         if (angle_pending_) {
           // The point's own angle. A lock the guard lost on the way belongs to the start: the new
           // angle setpoint hands the rotor to a fresh estimator, and the point is judged from here.
-          if (!check(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
+          if (!step(dev_.synrm->set_angle_deg(req_.angle_deg), "setting the current angle")) return;
           angle_pending_ = false;
           record_.lock_lost = false;
           lock_seen_ = false;
@@ -220,8 +271,18 @@ void PointProcedure::tick(double now_s) {
     }
     case PointPhase::measure: {
       if (!dev_.trigger->window_closed()) return;
-      read_results();
-      if (phase_ == PointPhase::failed) return;
+      if (t_results_due_ < 0) t_results_due_ = now_s;
+      const char* what = "";
+      if (const auto ec = read_results(what)) {
+        // The window's results stay on the devices until the next start: read again next tick.
+        tolerate(ec, what, now_s, t_results_due_);
+        return;
+      }
+      if (!error_.empty()) {
+        // An implausible result: nothing stored, the bench stopped as after a fault.
+        begin_stop(now_s, /*ramped=*/false);
+        return;
+      }
       if (opt_.ordered_stop_after) {
         begin_stop(now_s, /*ramped=*/true);
       } else {
@@ -238,13 +299,20 @@ void PointProcedure::tick(double now_s) {
   }
 }
 
-void PointProcedure::read_results() {
+std::error_code PointProcedure::read_results(const char*& what) {
   drivers::SynrmWindow w;
   drivers::LoadWindow lw;
   drivers::MeterReading m;
-  if (!check(dev_.synrm->read_window(w), "reading the SynRM drive window")) return;
-  if (!check(dev_.load->read_window(lw), "reading the load drive window")) return;
-  if (!check(dev_.meter->read(m), "reading the power meter")) return;
+  what = "reading the SynRM drive window";
+  if (auto ec = dev_.synrm->read_window(w)) return ec;
+  what = "reading the load drive window";
+  if (auto ec = dev_.load->read_window(lw)) return ec;
+  what = "reading the power meter";
+  if (auto ec = dev_.meter->read(m)) return ec;
+  if (const auto why = implausible_window(w, lw, m)) {
+    error_ = "implausible window result, point not stored: " + *why;
+    return {};
+  }
   auto& r = record_;
   r.speed_meas_rpm = w.speed_meas_rpm;
   r.im_A = w.im_A;
@@ -283,6 +351,7 @@ void PointProcedure::read_results() {
   if (w.fault != drivers::Fault::none) r.fault = std::string(drivers::fault_name(w.fault));
   if (dev_.truth) r.truth = dev_.truth->read_truth_window();
   has_record_ = true;
+  return {};
 }
 
 PointProcedure run_point(drivers::BenchDevices devices, drivers::Clock& clock,

@@ -34,6 +34,10 @@ struct PointOptions {
   double speed_reached_band_rpm = 5.0;
   double stop_speed_rpm = 20.0;         // below this the drives are disabled
   double stop_timeout_s = 30.0;        // the ordered stop's speed step, then disabled regardless
+  // A read that fails on the link (no reply, a garbled reply, an exception: errors the bus
+  // already repeated within its retry budget) skips the tick; the point fails only when no
+  // telemetry, or no window result, came for this long. The safety supervisor's link deadline.
+  double telemetry_timeout_s = 0.5;
   double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
   bool ordered_stop_after = true;
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
@@ -88,9 +92,18 @@ class PointProcedure {
   const std::string& error() const { return error_; }
   // The drive could not hold the commanded speed while settling (see PointOptions).
   bool speed_lost() const { return speed_lost_; }
+  // Failed reads the procedure skipped over (a lossy link), for logs and tests.
+  std::uint64_t tolerated_reads() const { return tolerated_reads_; }
 
  private:
   bool check(std::error_code ec, const char* what);
+  // A failed read at `now_s`: true while it is tolerated (the tick is skipped), else the point
+  // fails naming `what`. `since_s` is when reads last succeeded.
+  bool tolerate(std::error_code ec, const char* what, double now_s, double since_s);
+  // A command's result. Every step that commands is idempotent (setpoints, modes, enables), so a
+  // write the link lost is made again on the next tick: false (the caller returns) while that is
+  // tolerated, since `failing_since_s` (-1: not failing), else the point fails.
+  bool command(std::error_code ec, const char* what, double now_s, double& failing_since_s);
   // Opens the window on every instrument at once and measures (phase measure).
   void open_window(double now_s);
   // The load torque the procedure wants; ramp_load() moves the setpoint there each tick.
@@ -98,7 +111,9 @@ class PointProcedure {
   bool ramp_load(double now_s);
   // `ramped`: the load comes off at the bench's ramp (a measured point), else at once (a fault).
   void begin_stop(double now_s, bool ramped);
-  void read_results();
+  // The window's results into the record; on an error, `what` names the read. An implausible
+  // result fails the point (error_ set, errc::ok returned).
+  std::error_code read_results(const char*& what);
   void enter(PointPhase p, double now_s);
 
   drivers::BenchDevices dev_;
@@ -110,6 +125,11 @@ class PointProcedure {
   bool has_record_ = false, speed_lost_ = false;
   LoadRamp load_ramp_;
   double t_last_tick_ = -1;
+  double t_last_read_ = -1;     // telemetry last read (or the first tick)
+  double t_results_due_ = -1;   // the window closed; results since then
+  double t_step_failing_ = -1;  // a command of the current step failing on the link since
+  double t_ramp_failing_ = -1;  // the load ramp's writes failing since
+  std::uint64_t tolerated_reads_ = 0;
   bool load_pending_ = false;
   OrderedStop stop_;
   bool stop_ramped_ = false;  // the stop takes the load off at the ramp (a measured point)

@@ -31,7 +31,7 @@ SafetyLimits stricter(const SafetyLimits& a, const SafetyLimits& b) {
 
 SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits,
                                    EventSink sink)
-    : dev_(devices), lim_(limits), sink_(std::move(sink)) {}
+    : dev_(devices), lim_(limits), sink_(std::move(sink)), plausibility_(limits.plausibility) {}
 
 void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string detail) {
   if (trip_) return;  // the first cause is the one that counts
@@ -113,6 +113,7 @@ std::error_code SafetySupervisor::reset() {
   alarm_.reset();
   confirm_deadline_s_.reset();
   stop_duration_s_.reset();
+  plausibility_.reset();
   phase_ = SafetyPhase::normal;
   return {};
 }
@@ -155,6 +156,9 @@ void SafetySupervisor::tick(double now_s) {
   }
   if (load_ && !trip_ && load_->fault != drivers::Fault::none)
     raise(now_s, drivers::Fault::load_drive, "load drive reports " + std::string(drivers::fault_name(load_->fault)));
+  if (synrm_ && !trip_)
+    if (const auto bad = plausibility_.check(now_s, *synrm_))
+      raise(now_s, drivers::Fault::implausible_telemetry, "SynRM drive " + bad->describe());
 
   advance_stop(now_s);
   confirm_stop(now_s);

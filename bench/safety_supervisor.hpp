@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "bench/ordered_stop.hpp"
+#include "bench/telemetry_plausibility.hpp"
 #include "drivers/devices.hpp"
 
 namespace synbench::bench {
@@ -29,6 +30,7 @@ struct SafetyLimits {
   double stopped_speed_rpm = 20.0;
   // After a stop's disable, the drives must read back as not running within this long.
   double stop_confirm_s = 0.3;
+  PlausibilityLimits plausibility;  // implausible_telemetry (telemetry_plausibility.hpp)
 };
 
 // The stricter of two sets of limits, each bound on its own (a plan may tighten the bench's).
@@ -105,6 +107,7 @@ class SafetySupervisor {
   std::optional<SafetyAlarm> alarm_;
   std::optional<double> confirm_deadline_s_;
   std::optional<double> stop_duration_s_;
+  TelemetryPlausibility plausibility_;
 };
 
 }  // namespace synbench::bench

@@ -162,12 +162,13 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
   Parser p;
   BenchConfig c;
   if (!p.object(doc, "")) return {std::nullopt, p.errors};
-  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "links", "devices", "limits",
-                             "setpoints", "calibration"});
+  p.reject_unknown(doc, "", {"time_scale", "poll_period_ms", "window_margin_s", "retries", "retry_budget_ms", "links",
+                             "devices", "limits", "setpoints", "calibration"});
   if (auto v = p.number(doc, "", "time_scale", 0.001, 1000)) c.time_scale = *v;
   if (auto v = p.number(doc, "", "poll_period_ms", 1, 10000)) c.poll_period_ms = *v;
   if (auto v = p.number(doc, "", "window_margin_s", 0, 3600)) c.window_margin_s = *v;
-  if (auto v = p.number(doc, "", "retries", 0, 5, true)) c.retries = static_cast<int>(*v);
+  if (auto v = p.number(doc, "", "retries", 0, 10, true)) c.retries = static_cast<int>(*v);
+  if (auto v = p.number(doc, "", "retry_budget_ms", 0, 60000, false)) c.retry_budget_ms = *v;
 
   if (const auto l = doc.find("limits"); l != doc.end() && p.object(*l, "/limits")) {
     p.reject_unknown(*l, "/limits", {"max_speed_rpm", "max_current_A", "max_udc_V", "min_udc_V", "max_temp_C",

@@ -48,7 +48,8 @@ struct BenchConfig {
   double time_scale = 1.0;      // bench seconds per wall second; match `synbench emulate --time-scale`
   double poll_period_ms = 10;   // how often the bench reads telemetry
   double window_margin_s = 5;   // wait for a window's results this long past its end
-  int retries = 1;              // repeats of a request after a timeout or malformed reply
+  int retries = 3;              // at most this many repeats of a failed read or idempotent write
+  double retry_budget_ms = 250; // and none started later than this after the first attempt (bench time)
   std::map<std::string, LinkConfig> links;
   DeviceConfig synrm_drive, load_drive, vfc_meter;
   BenchLimitsConfig limits;            // the safety supervisor's trips

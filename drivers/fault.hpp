@@ -19,6 +19,10 @@ enum class Fault : std::uint16_t {
   estop = 7,
   link_loss = 8,
   load_drive = 9,
+  // The bench's own verdict, never a drive's code: the safety supervisor found telemetry no
+  // working drive reports (a value frozen bit for bit, current into a shaft at rest, a negative
+  // magnitude); bench/telemetry_plausibility.hpp.
+  implausible_telemetry = 10,
 };
 
 constexpr std::string_view fault_name(Fault f) {
@@ -33,6 +37,7 @@ constexpr std::string_view fault_name(Fault f) {
     case Fault::estop: return "estop";
     case Fault::link_loss: return "link_loss";
     case Fault::load_drive: return "load_drive";
+    case Fault::implausible_telemetry: return "implausible_telemetry";
   }
   return "unknown";
 }

@@ -128,6 +128,7 @@ std::error_code ModbusBus::ensure_connected() {
 
 std::error_code ModbusBus::fail(const Request& r, int err) {
   const MappedError m = map_modbus_errno(err);
+  last_exception_code_ = m.exception_code;
   {
     std::lock_guard lock(stats_mutex_);
     switch (m.fault) {

@@ -65,6 +65,7 @@ class ModbusBus : public RegisterBus {
   std::error_code write_registers(std::uint8_t unit_id, std::uint16_t address,
                                   std::span<const std::uint16_t> words) override;
   BusStats stats() const override;
+  int last_exception_code() const override { return last_exception_code_; }
   std::string last_error() const override;
   std::string name() const override { return name_; }
 
@@ -99,6 +100,7 @@ class ModbusBus : public RegisterBus {
   mutable std::mutex stats_mutex_;  // stats may be read from another thread
   BusStats stats_;
   std::string last_error_;
+  int last_exception_code_ = 0;  // owner thread only
 };
 
 class ModbusTcpBus final : public ModbusBus {

@@ -53,6 +53,10 @@ class RegisterBus {
                                           std::span<const std::uint16_t> words) = 0;
 
   virtual BusStats stats() const = 0;
+  // The Modbus exception code (1..11) of the last call that returned errc::exception_reply, 0
+  // when unknown: whether a refusal is worth repeating depends on it (busy, yes; illegal
+  // address, never).
+  virtual int last_exception_code() const { return 0; }
   // The last failure in words (link, unit, request and the transport's own message), for logs.
   virtual std::string last_error() const = 0;
   // "tcp 127.0.0.1:1502", "rtu /dev/ttyUSB0", "twin (in-process)".

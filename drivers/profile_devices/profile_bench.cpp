@@ -37,7 +37,7 @@ ProfileBench::ProfileBench(RegisterBus& synrm_bus, DeviceProfile synrm, Register
       clock_(std::make_unique<HeartbeatClock>(*this, clock)) {
   for (ProfileDevice* d : {static_cast<ProfileDevice*>(&synrm_), static_cast<ProfileDevice*>(&load_),
                            static_cast<ProfileDevice*>(&meter_)})
-    d->io().set_retries(options.retries);
+    d->io().set_retry_policy(options.retry, &clock);
 }
 
 ProfileBench::~ProfileBench() = default;

@@ -15,7 +15,8 @@ namespace synbench::drivers {
 
 struct ProfileBenchOptions {
   double window_margin_s = 5.0;  // see ProfileWindowTrigger
-  int retries = 1;               // see SignalIo::set_retries
+  // Repeats of failed reads and idempotent writes (retry_policy.hpp), in the clock's time.
+  RetryPolicy retry;
 };
 
 class ProfileBench {

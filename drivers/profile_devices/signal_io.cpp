@@ -56,11 +56,19 @@ void ReadPlan::plan(const DeviceProfile& profile, std::span<const std::string_vi
   }
 }
 
+bool SignalIo::may_repeat(std::error_code ec, int repeats, double first_s) const {
+  if (!ec || repeats >= policy_.max_retries || !retryable(ec, bus_.last_exception_code())) return false;
+  return !clock_ || clock_->now_s() - first_s < policy_.budget_s;
+}
+
 template <class Request>
 std::error_code SignalIo::with_retries(bool idempotent, Request&& request) {
+  const double first_s = now_s();
   std::error_code ec = request();
-  for (int i = 0; ec && idempotent && i < retries_ && (ec == errc::timeout || ec == errc::protocol); ++i)
+  for (int i = 0; idempotent && may_repeat(ec, i, first_s); ++i) {
+    ++repeats_;
     ec = request();
+  }
   return ec;
 }
 

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "drivers/bus/register_bus.hpp"
+#include "drivers/clock.hpp"
 #include "drivers/profile/device_profile.hpp"
+#include "drivers/profile_devices/retry_policy.hpp"
 
 namespace synbench::drivers {
 
@@ -53,10 +55,21 @@ class SignalIo {
  public:
   SignalIo(RegisterBus& bus, const DeviceProfile& profile) : bus_(bus), profile_(profile) {}
 
-  // How often a request is repeated after a timeout or a malformed reply (after which the bus
-  // has resynchronized, so a repeat cannot pick up the lost reply). Reads and idempotent writes
-  // only: a window start is never repeated (done twice it would not mean the same).
-  void set_retries(int retries) { retries_ = retries; }
+  // When a failed request is repeated (retry_policy.hpp): reads and idempotent writes only (a
+  // window start is never repeated here: done twice it would not mean the same; WindowChannel
+  // asks the device instead), within the policy's budget of `clock`'s time. Without a clock
+  // only the count bounds the repeats. Default: no repeats.
+  void set_retry_policy(const RetryPolicy& policy, const Clock* clock) {
+    policy_ = policy;
+    clock_ = clock;
+  }
+  const RetryPolicy& retry_policy() const { return policy_; }
+  // Whether a request first attempted at `first_s` (clock time) that failed with `ec` after
+  // `repeats` repeats may be made once more.
+  bool may_repeat(std::error_code ec, int repeats, double first_s) const;
+  double now_s() const { return clock_ ? clock_->now_s() : 0.0; }
+  // Repeats made so far (for tests and logs).
+  std::uint64_t repeats() const { return repeats_; }
 
   const DeviceProfile& profile() const { return profile_; }
   RegisterBus& bus() { return bus_; }
@@ -76,7 +89,9 @@ class SignalIo {
 
   RegisterBus& bus_;
   const DeviceProfile& profile_;
-  int retries_ = 0;
+  RetryPolicy policy_{0.0, 0};
+  const Clock* clock_ = nullptr;
+  std::uint64_t repeats_ = 0;
   std::vector<std::uint16_t> words_;
   std::vector<std::uint8_t> bits_;
 };

@@ -53,7 +53,21 @@ std::error_code WindowChannel::write_length_ms(double length_ms) {
 
 std::error_code WindowChannel::start() {
   if (!start_) return make_error_code(errc::not_supported);
-  return io_.write(start_->name, 1);
+  const double first_s = io_.now_s();
+  for (int repeats = 0;; ++repeats) {
+    const std::error_code ec = io_.write(start_->name, 1);  // SignalIo never repeats a start
+    if (!ec) return {};
+    if (!retryable(ec, io_.bus().last_exception_code()) || state_ != State::armed) return ec;
+    // Executed or not? The device knows (the read is itself retried within the budget).
+    double status = 0, sequence = 0;
+    if (read_status(status, sequence)) return ec;
+    if (status == kStatusOpen || (status == kStatusDone && sequence != armed_sequence_)) {
+      ++starts_confirmed_;
+      return {};
+    }
+    if (!io_.may_repeat(ec, repeats, first_s)) return ec;
+    ++start_repeats_;
+  }
 }
 
 std::error_code WindowChannel::poll(bool& done) {

@@ -26,7 +26,15 @@ class WindowChannel {
   // Reads the sequence the next window must move on from; errc::busy while one is open.
   std::error_code arm();
   std::error_code write_length_ms(double length_ms);
+  // Writes the start once. When the write fails in a way that leaves open whether the device
+  // executed it (no reply, a garbled reply, a transient exception), the device is asked: a
+  // window open, or closed with a sequence past the armed one, means the start was executed;
+  // status and sequence unchanged mean it was not, and only then is it written again (within
+  // the retry policy). A blind repeat could start a second window, or be refused as busy.
   std::error_code start();
+  // Starts written again after a lost reply, and starts found executed by the read-back.
+  std::uint64_t start_repeats() const { return start_repeats_; }
+  std::uint64_t starts_confirmed() const { return starts_confirmed_; }
   // Reads status and sequence (no I/O once done); `done` when the armed window has closed.
   std::error_code poll(bool& done);
   // The window did not close in time: its results are reported as errc::timeout.
@@ -48,6 +56,7 @@ class WindowChannel {
   ReadPlan status_plan_;
   State state_ = State::never;
   double armed_sequence_ = 0, done_sequence_ = 0;
+  std::uint64_t start_repeats_ = 0, starts_confirmed_ = 0;
 };
 
 }  // namespace synbench::drivers

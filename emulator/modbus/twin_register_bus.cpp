@@ -15,6 +15,7 @@ std::error_code TwinRegisterBus::transact(std::uint8_t unit_id, std::span<const 
   const std::size_t n = service_.handle(unit_id, request, std::span(reply_, kMaxPdu));
   if (n == 2 && reply_[0] == (request[0] | 0x80)) {
     ++stats_.exceptions;
+    last_exception_code_ = reply_[1];
     ++stats_.exceptions_by_code[reply_[1] < 12 ? reply_[1] : 0];
     last_error_ = "twin unit " + std::to_string(unit_id) + " function " + std::to_string(request[0]) +
                   ": exception " + std::to_string(reply_[1]);

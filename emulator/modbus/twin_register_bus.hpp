@@ -25,6 +25,7 @@ class TwinRegisterBus final : public drivers::RegisterBus {
                                   std::span<const std::uint16_t> words) override;
   drivers::BusStats stats() const override { return stats_; }
   std::string last_error() const override { return last_error_; }
+  int last_exception_code() const override { return last_exception_code_; }
   std::string name() const override { return "twin (in-process)"; }
 
  private:
@@ -34,6 +35,7 @@ class TwinRegisterBus final : public drivers::RegisterBus {
   TwinService& service_;
   drivers::BusStats stats_;
   std::string last_error_;
+  int last_exception_code_ = 0;
   std::uint8_t reply_[256];
 };
 

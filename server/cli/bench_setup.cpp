@@ -36,7 +36,8 @@ ConfiguredBench::ConfiguredBench(const drivers::BenchConfig& config, drivers::Be
   }
   drivers::ProfileBenchOptions options;
   options.window_margin_s = config.window_margin_s;
-  options.retries = config.retries;
+  options.retry.max_retries = config.retries;
+  options.retry.budget_s = config.retry_budget_ms / 1000.0;
   bench_ = std::make_unique<drivers::ProfileBench>(
       *buses_.at(config.synrm_drive.link), std::move(profiles.synrm_drive), *buses_.at(config.load_drive.link),
       std::move(profiles.load_drive), *buses_.at(config.vfc_meter.link), std::move(profiles.vfc_meter), *clock_,

@@ -58,6 +58,27 @@ TEST(BenchConfig, ParsesAValidConfig) {
   EXPECT_FALSE(c.on_twin());
 }
 
+TEST(BenchConfig, RetryCountAndBudget) {
+  {
+    const BenchConfigResult r = parse_bench_config(valid(), "/etc/synbench");
+    ASSERT_TRUE(r.config);
+    EXPECT_EQ(r.config->retries, 3);  // defaults (docs/bench-config.md)
+    EXPECT_DOUBLE_EQ(r.config->retry_budget_ms, 250);
+  }
+  json d = valid();
+  d["retries"] = 7;
+  d["retry_budget_ms"] = 120;
+  const BenchConfigResult r = parse_bench_config(d, "/etc/synbench");
+  ASSERT_TRUE(r.config) << errors_of(d);
+  EXPECT_EQ(r.config->retries, 7);
+  EXPECT_DOUBLE_EQ(r.config->retry_budget_ms, 120);
+  d["retries"] = 11;
+  d["retry_budget_ms"] = -1;
+  const std::string e = errors_of(d);
+  EXPECT_NE(e.find("/retries: 11 is outside [0, 10]"), std::string::npos) << e;
+  EXPECT_NE(e.find("/retry_budget_ms: -1 is outside [0, 60000]"), std::string::npos) << e;
+}
+
 TEST(BenchConfig, EveryProblemNamesItsField) {
   json d = valid();
   d["time_scale"] = 0;

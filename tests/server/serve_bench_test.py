@@ -44,7 +44,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import far_side as fs  # noqa: E402
 
 BIN = sys.argv[1]
-LINKS = sys.argv[2:] or ["tcp", "rtu", "cli"]
+LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow"]
 WATCHDOG_MS = 3000
 ESTOP_DEADLINE_S = 1.0    # the issue's bound: request sent -> both drives read disabled
 STAY_S = 2.0              # and they stay disabled this long
@@ -367,12 +367,49 @@ def run_cli(tmp):
         emu.stop()
 
 
+def run_slow(tmp):
+    """Drives that answer every request 150 ms late (inside the link's 200 ms timeout): the bench
+    thread's ticks take a second, but nothing that reads the status waits for them, and a command
+    still gets its answer once the slow drives have acted."""
+    print("--- a slow device: every reply 150 ms late")
+    emu = fs.Emulator(BIN, os.path.join(tmp, "slow_emulate.log"),
+                      args=["--watchdog-timeout-ms", str(WATCHDOG_MS), "--duration-s", "900",
+                            "--fault-delay-pct", "100", "--fault-delay-ms", "150"])
+    serve = None
+    try:
+        cfg = fs.write_bench_config(os.path.join(tmp, "slow_bench.json"), fs.tcp_link(emu.port))
+        serve = fs.Serve(BIN, cfg, os.path.join(tmp, "slow_data"), os.path.join(tmp, "slow_serve.log"), start_timeout_s=SLOW_S)
+        time.sleep(1.0)  # the bench thread is now in its slow ticks
+        worst = {}
+        for path in ("/api/health", "/api/bench/status", "/metrics"):
+            times = []
+            for _ in range(20):
+                t0 = time.perf_counter()
+                status, _ = serve.request("GET", path)
+                times.append(time.perf_counter() - t0)
+                if status != 200:
+                    check(False, "slow: GET %s -> %s" % (path, status))
+            worst[path] = max(times) * 1000
+        check(all(ms < 100 for ms in worst.values()),
+              "slow: reads never wait for the drives (worst of 20 each: %s)"
+              % ", ".join("%s %.1f ms" % (p, ms) for p, ms in worst.items()))
+        t0 = time.perf_counter()
+        status, body = serve.request("POST", "/api/bench/setpoints", {"speed_rpm": 200})
+        took = time.perf_counter() - t0
+        check(status == 200 and isinstance(body, dict) and body.get("setpoints", {}).get("speed_rpm") == 200,
+              "slow: a command is still answered once acted on (%s in %.2f s)" % (status, took))
+    finally:
+        if serve:
+            serve.stop()
+        emu.stop()
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="synbench_serve_bench_")
     try:
         for kind in LINKS:
             try:
-                run_cli(tmp) if kind == "cli" else run_link(kind, tmp)
+                {"cli": run_cli, "slow": run_slow}.get(kind, lambda t: run_link(kind, t))(tmp)
             except (RuntimeError, OSError, fs.ModbusError) as e:
                 check(False, "%s: %s" % (kind, e))
     finally:

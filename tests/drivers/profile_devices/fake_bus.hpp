@@ -69,11 +69,13 @@ class FakeBus final : public RegisterBus {
   }
   BusStats stats() const override { return {}; }
   std::string last_error() const override { return {}; }
+  int last_exception_code() const override { return exception_code; }
   std::string name() const override { return "fake"; }
 
   std::vector<Request> log;
   std::function<void(const Request&)> before;  // runs before each request is served
   std::error_code fail_next;                   // returned by the next request, once
+  int exception_code = 0;                      // what last_exception_code() says
 
  private:
   std::error_code begin(const Request& r) {

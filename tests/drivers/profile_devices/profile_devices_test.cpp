@@ -199,23 +199,94 @@ TEST_F(WindowFixture, AnOpenWindowIsBusy) {
   EXPECT_EQ(bench.trigger().open_window(1.0), errc::busy);
 }
 
-TEST_F(WindowFixture, ATimedOutReadIsRepeatedOnceAWindowStartNever) {
+TEST_F(WindowFixture, ALostReplyOrATransientExceptionIsRepeatedARefusalNever) {
   bus.at(1, RegisterKind::input, 0) = 1;  // running
   bus.fail_next = make_error_code(errc::timeout);
   SynrmTelemetry t;
   ASSERT_FALSE(bench.synrm().read(t));
   EXPECT_EQ(t.state, DriveState::running);
   EXPECT_EQ(bus.log.size(), 4u);  // three requests, the first one twice
-  bus.fail_next = make_error_code(errc::exception_reply);  // a refusal is an answer: no repeat
+  // Exception 6, server device busy: not now, so again.
+  bus.log.clear();
+  bus.fail_next = make_error_code(errc::exception_reply);
+  bus.exception_code = 6;
+  ASSERT_FALSE(bench.synrm().read(t));
+  EXPECT_EQ(bus.log.size(), 4u);
+  // Exception 2, illegal data address: the same request gets the same answer.
+  bus.log.clear();
+  bus.fail_next = make_error_code(errc::exception_reply);
+  bus.exception_code = 2;
   EXPECT_EQ(bench.synrm().read(t), errc::exception_reply);
+  EXPECT_EQ(bus.log.size(), 1u);
+}
+
+TEST_F(WindowFixture, RepeatsStopAtTheRetryBudgetOrTheCount) {
+  // Every request fails after 0.1 s of bench time: repeats start only within the 0.25 s budget.
+  bus.before = [&](const FakeBus::Request&) {
+    clock.t += 0.1;
+    bus.fail_next = make_error_code(errc::timeout);
+  };
+  SynrmTelemetry t;
+  EXPECT_EQ(bench.synrm().read(t), errc::timeout);
+  EXPECT_EQ(bus.log.size(), 3u);  // at 0, 0.1 and 0.2 s; none at 0.3 s
+  // Failures that take no time: the count (3 repeats) bounds them.
+  bus.log.clear();
+  bus.before = [&](const FakeBus::Request&) { bus.fail_next = make_error_code(errc::protocol); };
+  EXPECT_EQ(bench.synrm().read(t), errc::protocol);
+  EXPECT_EQ(bus.log.size(), 4u);
+}
+
+int starts_on(const FakeBus& bus, std::uint8_t unit) {
+  int n = 0;
+  for (const auto& r : bus.log) n += r.op == "write" && r.kind == RegisterKind::coil && r.address == 2 && r.unit_id == unit;
+  return n;
+}
+
+TEST_F(WindowFixture, AStartWhoseReplyWasLostIsReadBackNotRepeated) {
+  set_window(2, 5);
+  // The drive executes the start (its window opens) but the reply is lost.
+  bool lost = false;
+  bus.before = [&](const FakeBus::Request& r) {
+    if (r.op == "write" && r.kind == RegisterKind::coil && r.address == 2 && r.unit_id == 1 && !lost) {
+      lost = true;
+      bus.at(1, RegisterKind::input, 100) = 1;
+      bus.fail_next = make_error_code(errc::timeout);
+    }
+  };
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  EXPECT_EQ(starts_on(bus, 1), 1);  // a second start would open a second window (or be busy)
+  EXPECT_EQ(bench.synrm().window().starts_confirmed(), 1u);
+  EXPECT_EQ(starts_on(bus, 2), 1);
+  EXPECT_EQ(starts_on(bus, 3), 1);
+}
+
+TEST_F(WindowFixture, AStartThatWasNotExecutedIsWrittenAgain) {
+  set_window(2, 5);
+  // Refused before execution (exception 4, as `synbench emulate` injects): status and sequence
+  // unchanged, so the start is written again.
+  bool refused = false;
+  bus.before = [&](const FakeBus::Request& r) {
+    if (r.op == "write" && r.kind == RegisterKind::coil && r.address == 2 && r.unit_id == 1 && !refused) {
+      refused = true;
+      bus.exception_code = 4;
+      bus.fail_next = make_error_code(errc::exception_reply);
+    }
+  };
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  EXPECT_EQ(starts_on(bus, 1), 2);
+  EXPECT_EQ(bench.synrm().window().start_repeats(), 1u);
+}
+
+TEST_F(WindowFixture, AStartRefusedForGoodIsNotRepeated) {
   set_window(2, 5);
   bus.before = [&](const FakeBus::Request& r) {
-    if (r.op == "write" && r.kind == RegisterKind::coil && r.address == 2) bus.fail_next = make_error_code(errc::timeout);
+    if (r.op == "write" && r.kind == RegisterKind::coil && r.address == 2 && r.unit_id == 1) {
+      bus.exception_code = 3;
+      bus.fail_next = make_error_code(errc::exception_reply);
+    }
   };
-  EXPECT_EQ(bench.trigger().open_window(1.0), errc::timeout);
-  int starts = 0;
-  for (const auto& r : bus.log) starts += r.op == "write" && r.kind == RegisterKind::coil && r.address == 2;
-  EXPECT_EQ(starts, 1);
+  EXPECT_EQ(bench.trigger().open_window(1.0), errc::exception_reply);
+  EXPECT_EQ(starts_on(bus, 1), 1);
 }
 
 TEST_F(WindowFixture, TheClockSendsHeartbeatsWhileTheBenchWaits) {

@@ -85,7 +85,10 @@ TEST_F(TwinFixture, WatchdogStopsBothDrivesInOrderAndLatchesUntilReset) {
   bench.clock().wait_until(clock.now_s() + 1.0);
   EXPECT_EQ(synrm().state, DriveState::faulted);
   EXPECT_EQ(bench.synrm().enable(true), errc::exception_reply);
-  EXPECT_EQ(bus.stats().exceptions_by_code[modbus::kServerDeviceFailure], 1u);
+  // Exception 4 may be transient (a busy firmware task, a lossy line): the bench repeats it within
+  // its retry policy, and the refusal still comes through as the answer.
+  const auto tries = 1u + static_cast<unsigned>(drivers::RetryPolicy{}.max_retries);
+  EXPECT_EQ(bus.stats().exceptions_by_code[modbus::kServerDeviceFailure], tries);
   ASSERT_FALSE(bench.synrm().reset_fault());
   ASSERT_FALSE(bench.load().reset_fault());
   const auto reset = synrm();
@@ -170,7 +173,9 @@ TEST_F(TwinFixture, WindowStartedTwiceOnOneDeviceIsBusy) {
 TEST_F(TwinFixture, TheEstimatorChangesOnlyWithTheGatesOff) {
   spin_up(300);
   EXPECT_EQ(bench.synrm().set_estimator(drivers::Estimator::hfi), errc::exception_reply);
-  EXPECT_EQ(bus.stats().exceptions_by_code[modbus::kServerDeviceBusy], 1u);
+  // Busy is repeated within the retry policy (idempotent write), then reported.
+  EXPECT_EQ(bus.stats().exceptions_by_code[modbus::kServerDeviceBusy],
+            1u + static_cast<unsigned>(drivers::RetryPolicy{}.max_retries));
 }
 
 TEST_F(TwinFixture, AStuckSequenceNeverYieldsResults) {

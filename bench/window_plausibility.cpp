@@ -1,0 +1,78 @@
+// Window results no window can have.
+#include "bench/window_plausibility.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace synbench::bench {
+namespace {
+
+// A current magnitude's own rounding in a register (and a third-party drive's offset).
+constexpr double kMagnitudeTolerance_A = 0.01;
+// As for the live telemetry (telemetry_plausibility.hpp): a lab winding sensor's range.
+constexpr double kMinTemp_C = -30.0, kMaxTemp_C = 250.0;
+constexpr double kMinUdc_V = -5.0;
+
+std::string say(const char* field, const char* fmt, double a, double b = 0) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, fmt, a, b);
+  return std::string(field) + ": " + buf;
+}
+
+}  // namespace
+
+std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, const drivers::LoadWindow& load,
+                                              const drivers::MeterReading& meter) {
+  const struct {
+    const char* field;
+    double value;
+  } finite[] = {
+      {"window_s", w.window_s},         {"window_speed_meas_rpm", w.speed_meas_rpm},
+      {"window_im_A", w.im_A},          {"window_id_A", w.id_A},
+      {"window_iq_A", w.iq_A},          {"window_ud_V", w.ud_V},
+      {"window_uq_V", w.uq_V},          {"window_udc_V", w.udc_V},
+      {"window_temp_C", w.temp_C},      {"window_voltage_limited_fraction", w.voltage_limited_fraction},
+      {"window_fallback_fraction", w.fallback_fraction}, {"window_lock_lost_fraction", w.lock_lost_fraction},
+      {"window_torque_Nm", load.torque_Nm}, {"gate_s", meter.gate_s},
+      {"idcm_A", meter.idcm_A},         {"idcg_A", meter.idcg_A},
+  };
+  for (const auto& f : finite)
+    if (!std::isfinite(f.value)) return say(f.field, "%g is not a finite number", f.value);
+  const struct {
+    const char* field;
+    const std::optional<double>& value;
+  } estimates[] = {
+      {"window_pos_err_min_deg", w.pos_err_min_deg}, {"window_pos_err_mean_deg", w.pos_err_mean_deg},
+      {"window_pos_err_max_deg", w.pos_err_max_deg}, {"window_speed_err_rpm", w.speed_err_rpm},
+      {"window_ld_est_H", w.ld_est_H},               {"window_lq_est_H", w.lq_est_H},
+      {"window_rs_est_ohm", w.rs_est_ohm},
+  };
+  for (const auto& e : estimates)
+    if (e.value && !std::isfinite(*e.value)) return say(e.field, "%g is not a finite number", *e.value);
+
+  if (w.samples == 0) return std::string("window_samples: 0, a window without samples");
+  if (!(w.window_s > 0)) return say("window_s", "%g s: a window has a length", w.window_s);
+  if (w.im_A < -kMagnitudeTolerance_A)
+    return say("window_im_A", "%g A is negative: it is the mean of a current magnitude", w.im_A);
+  // The mean of a vector's magnitude is never less than the magnitude of its mean (the
+  // triangle inequality): an I_m below hypot(I_d, I_q) was not measured with them.
+  const double im_min = std::hypot(w.id_A, w.iq_A) * (1 - 1e-3) - kMagnitudeTolerance_A;
+  if (w.im_A < im_min)
+    return say("window_im_A", "%g A is less than the magnitude of the window's mean (I_d, I_q), %g A", w.im_A,
+               std::hypot(w.id_A, w.iq_A));
+  if (w.udc_V < kMinUdc_V) return say("window_udc_V", "%g V is negative: the DC bus never reverses", w.udc_V);
+  if (w.temp_C < kMinTemp_C || w.temp_C > kMaxTemp_C)
+    return say("window_temp_C", "%g degC is outside a winding's [-30, 250] degC", w.temp_C);
+  const struct {
+    const char* field;
+    double value;
+  } fractions[] = {{"window_voltage_limited_fraction", w.voltage_limited_fraction},
+                   {"window_fallback_fraction", w.fallback_fraction},
+                   {"window_lock_lost_fraction", w.lock_lost_fraction}};
+  for (const auto& f : fractions)
+    if (f.value < -1e-6 || f.value > 1 + 1e-6) return say(f.field, "%g is not a fraction in [0, 1]", f.value);
+  if (meter.gate_s < 0) return say("gate_s", "%g s is negative", meter.gate_s);
+  return std::nullopt;
+}
+
+}  // namespace synbench::bench
