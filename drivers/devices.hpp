@@ -15,6 +15,17 @@ namespace synbench::drivers {
 
 enum class DriveState : std::uint16_t { disabled = 0, running = 1, stopping = 2, faulted = 3 };
 
+// The state as the API, the command line and the database name it.
+constexpr const char* state_name(DriveState s) {
+  switch (s) {
+    case DriveState::disabled: return "disabled";
+    case DriveState::running: return "running";
+    case DriveState::stopping: return "stopping";
+    case DriveState::faulted: return "faulted";
+  }
+  return "?";
+}
+
 // Gates on: running, or in the drive's own ordered stop.
 inline bool running(DriveState s) { return s == DriveState::running || s == DriveState::stopping; }
 

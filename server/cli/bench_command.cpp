@@ -36,25 +36,16 @@ faulted, or runs, 2 bad input
 
 namespace {
 
-const char* state_name(drivers::DriveState s) {
-  switch (s) {
-    case drivers::DriveState::disabled: return "disabled";
-    case drivers::DriveState::running: return "running";
-    case drivers::DriveState::stopping: return "stopping";
-    case drivers::DriveState::faulted: return "faulted";
-  }
-  return "?";
-}
 
 nlohmann::json drives_json(const bench::SafetySupervisor& s) {
   nlohmann::json j;
   if (const auto& t = s.synrm())
-    j["synrm"] = {{"state", state_name(t->state)}, {"fault", std::string(drivers::fault_name(t->fault))},
+    j["synrm"] = {{"state", drivers::state_name(t->state)}, {"fault", std::string(drivers::fault_name(t->fault))},
                   {"speed_rpm", t->speed_rpm}, {"im_A", t->im_A}, {"udc_V", t->udc_V}};
   else
     j["synrm"] = nullptr;
   if (const auto& t = s.load())
-    j["load"] = {{"state", state_name(t->state)}, {"fault", std::string(drivers::fault_name(t->fault))},
+    j["load"] = {{"state", drivers::state_name(t->state)}, {"fault", std::string(drivers::fault_name(t->fault))},
                  {"torque_Nm", t->torque_Nm}};
   else
     j["load"] = nullptr;

@@ -40,15 +40,6 @@ std::variant<nlohmann::json, Response> parse_json_object(const std::string& body
 namespace {
 
 
-const char* state_name(drivers::DriveState s) {
-  switch (s) {
-    case drivers::DriveState::disabled: return "disabled";
-    case drivers::DriveState::running: return "running";
-    case drivers::DriveState::stopping: return "stopping";
-    case drivers::DriveState::faulted: return "faulted";
-  }
-  return "?";
-}
 
 Response bad_field(const std::string& field, const std::string& reason) {
   return error_response(400, "bad_field", field + ": " + reason);
@@ -145,13 +136,13 @@ nlohmann::json status_json(const BenchStatus& s) {
                   {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
                   {"temp_C", t.temp_C},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
                   {"pos_err_deg", t.pos_err_deg ? nlohmann::json(*t.pos_err_deg) : nlohmann::json(nullptr)},
-                  {"state", state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
+                  {"state", drivers::state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
   } else {
     j["synrm"] = nullptr;
   }
   if (s.load) {
     const auto& t = *s.load;
-    j["load"] = {{"torque_Nm", t.torque_Nm}, {"iq_A", t.iq_A}, {"state", state_name(t.state)},
+    j["load"] = {{"torque_Nm", t.torque_Nm}, {"iq_A", t.iq_A}, {"state", drivers::state_name(t.state)},
                  {"fault", std::string(drivers::fault_name(t.fault))}};
   } else {
     j["load"] = nullptr;

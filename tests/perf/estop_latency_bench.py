@@ -67,15 +67,6 @@ class TrialError(Exception):
     pass
 
 
-def wait_for(pred, timeout_s, period_s=0.02):
-    deadline = time.monotonic() + timeout_s
-    while True:
-        v = pred()
-        if v or time.monotonic() > deadline:
-            return v
-        time.sleep(period_s)
-
-
 def percentile(sorted_values, p):
     """Nearest rank."""
     return sorted_values[max(0, math.ceil(p / 100 * len(sorted_values)) - 1)]
@@ -120,7 +111,7 @@ class Bench:
             if status != 200:
                 raise TrialError("reset -> %s %s" % (status, str(body)[:160]))
             self.latched = False
-        if not wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
+        if not fs.wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
             raise TrialError("drives not disabled and clear before the trial: %s" % fs.describe(self.far.states()))
         sid = None
         if condition == "sweep":
@@ -135,7 +126,7 @@ class Bench:
             status, body = self.serve.request("POST", "/api/bench/enable", {"enabled": True})
             if status != 200:
                 raise TrialError("enable -> %s %s" % (status, str(body)[:160]))
-        if not wait_for(self.running, SLOW_S, 0.02):
+        if not fs.wait_for(self.running, SLOW_S, 0.02):
             raise TrialError("not at speed: %s, %.0f rpm" % (fs.describe(self.far.states()), self.far.speed_rpm()))
         time.sleep(random.uniform(0, 0.05))
         pending = fs.PendingRequest(self.serve.port, self.serve.raw_request_bytes("POST", "/api/bench/estop"))
@@ -156,7 +147,7 @@ class Bench:
                              % (GIVE_UP_S, fs.describe(states), pending.status))
         if pending.status != 200:
             raise TrialError("E-stop -> %s %s" % (pending.status, pending.body[:160] if pending.body else ""))
-        if sid is not None and not wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
+        if sid is not None and not fs.wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
             raise TrialError("sweep %d still running after the E-stop" % sid)
         return latency, pending.answered_at - pending.sent_at
 

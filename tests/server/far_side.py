@@ -37,6 +37,16 @@ TORQUE = 16           # load input 16-17, f32 N m
 UDC = 30              # SynRM input 30, u16, 0.1 V
 
 
+def wait_for(pred, timeout_s, period_s=0.02):
+    """Polls pred() until it returns a true value (returned) or the time is up (the last value)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        v = pred()
+        if v or time.monotonic() > deadline:
+            return v
+        time.sleep(period_s)
+
+
 class ModbusError(Exception):
     pass
 

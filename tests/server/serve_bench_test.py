@@ -72,16 +72,6 @@ def note(what):
     print("     " + what)
 
 
-def wait_for(pred, timeout_s, period_s=0.02):
-    """Polls pred() until it returns a true value (returned) or the time is up (the last value)."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        v = pred()
-        if v or time.monotonic() > deadline:
-            return v
-        time.sleep(period_s)
-
-
 def both(state):
     return lambda far: all(s == state for s, _ in far.states())
 
@@ -170,7 +160,7 @@ def run_link(kind, tmp):
         check(sp[0] == SPEED and abs(sp[1] - ANGLE) < 0.006 and sp[2] == LOAD_NM,
               "%s: setpoint registers when the reply arrives: speed %.1f rpm (SynRM holding 16-17 f32), angle %.2f deg (holding 18 i16 "
               "x0.01), torque %.2f N m (load holding 16-17 f32)" % (kind, sp[0], sp[1], sp[2]))
-        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
         check(spun, "%s: the shaft turns at %.0f rpm (SynRM input 16-17 f32: %.1f rpm), %s"
               % (kind, SPEED, far.speed_rpm(), fs.describe(far.states())))
         hb0 = far.heartbeats()
@@ -182,7 +172,7 @@ def run_link(kind, tmp):
         # 3. The ordered stop.
         status, body = serve.request("POST", "/api/bench/enable", {"enabled": False})
         check(status == 200, "%s: POST /api/bench/enable false -> 200 (%s)" % (kind, status))
-        ok = wait_for(lambda: both(fs.DISABLED)(far), SLOW_S, 0.05)
+        ok = fs.wait_for(lambda: both(fs.DISABLED)(far), SLOW_S, 0.05)
         check(ok, "%s: the ordered stop ends with both drives disabled: %s, %.1f rpm"
               % (kind, fs.describe(far.states()), far.speed_rpm()))
 
@@ -192,7 +182,7 @@ def run_link(kind, tmp):
         sid = sweep.get("id") if isinstance(sweep, dict) else None
         status, body = serve.request("POST", "/api/sweeps/%s/start" % sid)
         check(status == 202, "%s: POST /api/sweeps/%s/start -> 202 (%s %s)" % (kind, sid, status, str(body)[:200]))
-        spun = wait_for(lambda: running_at(far, SPEED, 0.5 * SPEED), SLOW_S, 0.05)
+        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.5 * SPEED), SLOW_S, 0.05)
         check(spun, "%s: the sweep runs the drives: %s, %.1f rpm" % (kind, fs.describe(far.states()), far.speed_rpm()))
         state = sweep_state(serve, sid)
         check(state == "running", "%s: the sweep is running when the E-stop comes (%s)" % (kind, state))
@@ -221,7 +211,7 @@ def run_link(kind, tmp):
         sup = st.get("supervisor", {}) if isinstance(st, dict) else {}
         check(sup.get("phase") == "estopped" and sup.get("tripped"),
               "%s: the daemon says estopped (%s)" % (kind, sup))
-        ended = wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
+        ended = fs.wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
         check(ended, "%s: the sweep stops running (%s)" % (kind, sweep_state(serve, sid)))
 
         # 6. The drives' own watchdog, the second line: the load drive is enabled behind the
@@ -233,7 +223,7 @@ def run_link(kind, tmp):
             t0 = time.monotonic()
             check(far.state(fs.LOAD)[0] == fs.RUNNING, "%s: the far side enables the load drive at 0 N m" % kind)
             # (A watchdog trip passes through stopping, the torque ramped to zero, to faulted.)
-            wait_for(lambda: far.state(fs.LOAD)[0] in (fs.DISABLED, fs.FAULTED), WATCHDOG_MS / 1000 + 3, 0.01)
+            fs.wait_for(lambda: far.state(fs.LOAD)[0] in (fs.DISABLED, fs.FAULTED), WATCHDOG_MS / 1000 + 3, 0.01)
             dt = time.monotonic() - t0
             end = far.states()
             tripped = end[1] == (fs.FAULTED, fs.WATCHDOG)
@@ -268,7 +258,7 @@ def run_link(kind, tmp):
         check(status == 200, "%s: POST /api/bench/enable after the reset -> 200 (%s %s)" % (kind, status, str(body)[:200]))
         check(was_off and all(s == fs.RUNNING for s, _ in now),
               "%s: both drives, disabled before, read running when the reply arrives: %s" % (kind, fs.describe(now)))
-        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
         check(was_off and spun and far.speed_setpoint_rpm() == SPEED,
               "%s: the drives, disabled before, run again at %.0f rpm: %s, %.1f rpm, setpoint register %.1f%s"
               % (kind, SPEED, fs.describe(far.states()), far.speed_rpm(), far.speed_setpoint_rpm(),
