@@ -27,6 +27,7 @@
 #include "server/http/router.hpp"
 #include "server/http/sweep_routes.hpp"
 #include "server/http/tokens.hpp"
+#include "server/http/worker.hpp"
 #include "server/http/ws_hub.hpp"
 #include "synbench/version.hpp"
 
@@ -64,6 +65,10 @@ the default (docs/deployment.md):
                        SYNBENCH_ALLOW_HOSTS (comma-separated), "allow_hosts": a Host header value
                        accepted besides the listen address (the name a proxy or a published
                        container port is reached by); repeatable
+  --allow-remote-plain-http
+                       SYNBENCH_ALLOW_REMOTE_PLAIN_HTTP=1, "allow_remote_plain_http": true:
+                       accept a --listen address other than loopback (plain HTTP: tokens in the
+                       clear; prints a warning). Without it such an address is refused (exit 2)
   --allow-origin ORIGIN
                        SYNBENCH_ALLOW_ORIGINS (comma-separated), "allow_origins": a browser origin
                        (scheme://host[:port]) allowed to open /ws besides http:// + an allowed
@@ -90,6 +95,9 @@ int serve_command(const std::vector<std::string>& argv) {
     return 2;
   }
   const std::string& host = options.listen_host;
+  if (!is_loopback(host))
+    std::cerr << "synbench serve: WARNING: listening on " << host << " over plain HTTP (--allow-remote-plain-http): "
+              << "bearer tokens cross the network in the clear; put a TLS proxy in front (docs/deployment.md)\n";
   const std::uint16_t port = options.listen_port;
   const std::filesystem::path& data_dir = options.data_dir;
   const emulator::TwinConfig& config = options.twin;
@@ -146,7 +154,10 @@ int serve_command(const std::vector<std::string>& argv) {
                   {"bench", nlohmann::ordered_json::parse(in, nullptr, false)},
                   {"devices", nlohmann::ordered_json::parse(bench.devices_json().dump())}};
   }
-  http::add_sweep_routes(router, *store, bench, control, data_dir / "synbench.db", bench_meta);
+  // The estimate, exports and analyses on a thread of their own: the io thread stays free for
+  // the E-stop.
+  http::Worker worker;
+  http::add_sweep_routes(router, *store, bench, control, worker, data_dir / "synbench.db", bench_meta);
 
   boost::asio::io_context io(1);
   http::HttpServer server(io, router, http::ServerLimits{},
@@ -162,6 +173,7 @@ int serve_command(const std::vector<std::string>& argv) {
     const auto h = weak.lock();
     return h ? http::WsCounts{h->session_count(), h->dropped()} : http::WsCounts{};
   });
+  metrics.set_connection_source([&server] { return http::ConnectionCounts{server.connections(), server.evicted()}; });
   hub->start();
   if (auto e = server.listen(host, port)) {
     std::cerr << "synbench serve: cannot listen on " << host << ":" << port << ": " << e.message() << "\n";
@@ -198,6 +210,7 @@ int serve_command(const std::vector<std::string>& argv) {
   std::cout << "listening on http://" << (v6 ? "[" + host + "]" : host) << ":" << server.port() << std::endl;
   std::cerr << "synbench serve: bench: " << bench_what << "\n";
   io.run();
+  worker.stop();  // its answers go to the io_context, which must outlive them
   if (stopper.joinable()) stopper.join();
   bench.shutdown();
   std::cerr << "synbench serve: stopped\n";

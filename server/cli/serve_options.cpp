@@ -35,6 +35,7 @@ std::vector<std::string> split_list(const std::string& list) {
 // The daemon config file: every key optional, unknown keys rejected, paths relative to the file.
 struct FileSettings {
   std::optional<std::string> listen;
+  bool allow_remote_plain_http = false;
   std::optional<std::filesystem::path> data_dir, web_dir, bench;
   std::optional<nlohmann::json> twin;  // an object, or a file name resolved to its contents
   std::optional<std::filesystem::path> twin_file;
@@ -76,7 +77,8 @@ FileSettings read_config_file(const std::filesystem::path& file, const std::stri
     }
     return out;
   };
-  static const std::set<std::string> known{"listen", "data_dir", "web_dir", "bench", "twin", "allow_hosts", "allow_origins"};
+  static const std::set<std::string> known{"listen",      "data_dir",      "web_dir", "bench", "twin", "allow_hosts",
+                                           "allow_origins", "allow_remote_plain_http"};
   FileSettings s;
   for (const auto& [key, value] : doc.items()) {
     if (!key.empty() && key.front() == '_') continue;  // comments, as in config/twin.json
@@ -87,6 +89,10 @@ FileSettings read_config_file(const std::filesystem::path& file, const std::stri
     }
   }
   if (doc.contains("listen")) s.listen = text("listen");
+  if (doc.contains("allow_remote_plain_http")) {
+    if (!doc["allow_remote_plain_http"].is_boolean()) throw at("allow_remote_plain_http", "must be true or false");
+    s.allow_remote_plain_http = doc["allow_remote_plain_http"].get<bool>();
+  }
   if (doc.contains("data_dir")) s.data_dir = path("data_dir");
   if (doc.contains("web_dir")) s.web_dir = path("web_dir");
   if (doc.contains("bench")) s.bench = path("bench");
@@ -112,6 +118,10 @@ EnvLookup process_env() {
     if (!v || !*v) return std::nullopt;
     return std::string(v);
   };
+}
+
+bool is_loopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
 }
 
 void parse_listen(const std::string& text, const std::string& what, std::string& host, std::uint16_t& port) {
@@ -145,7 +155,7 @@ std::string parse_host_value(std::string text, const std::string& what) {
 
 ServeOptions parse_serve_options(const std::vector<std::string>& argv, const EnvLookup& env,
                                  const std::filesystem::path& default_web_dir) {
-  Args a(argv, {"--help"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir"},
+  Args a(argv, {"--help", "--allow-remote-plain-http"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir"},
          {"--allow-host", "--allow-origin"});
   if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
   ServeOptions o;
@@ -168,7 +178,17 @@ ServeOptions parse_serve_options(const std::vector<std::string>& argv, const Env
     return p ? std::optional<std::string>(p->string()) : std::nullopt;
   };
 
-  if (auto v = pick("--listen", "SYNBENCH_LISTEN", file.listen)) parse_listen(v->first, v->second, o.listen_host, o.listen_port);
+  std::string listen_from = "--listen";
+  if (auto v = pick("--listen", "SYNBENCH_LISTEN", file.listen)) {
+    parse_listen(v->first, v->second, o.listen_host, o.listen_port);
+    listen_from = v->second;
+  }
+  o.allow_remote_plain_http = a.has("--allow-remote-plain-http") || env("SYNBENCH_ALLOW_REMOTE_PLAIN_HTTP") == "1" ||
+                              file.allow_remote_plain_http;
+  if (!is_loopback(o.listen_host) && !o.allow_remote_plain_http)
+    throw UsageError(listen_from, "'" + o.listen_host + "' is not a loopback address: the API is plain HTTP, so bearer "
+                                  "tokens would cross the network in the clear. Serve it on loopback behind a TLS "
+                                  "proxy (docs/deployment.md), or confirm with --allow-remote-plain-http");
   if (auto v = pick("--data-dir", "SYNBENCH_DATA_DIR", opt_path(file.data_dir))) {
     if (v->first.empty()) throw UsageError(v->second, "needs a directory");
     o.data_dir = v->first;

@@ -25,7 +25,13 @@ struct ServeOptions {
   std::optional<std::filesystem::path> bench;    // a bench config: real drives or `synbench emulate`
   std::vector<std::string> allow_hosts;          // extra Host values ("name:port"), lower case
   std::vector<std::string> allow_origins;        // extra WebSocket origins ("scheme://host[:port]")
+  // A --listen address other than loopback is refused unless this confirms it: the API is plain
+  // HTTP, so bearer tokens would cross the network in the clear.
+  bool allow_remote_plain_http = false;
 };
+
+// 127.0.0.0/8, ::1 or localhost.
+bool is_loopback(const std::string& host);
 
 using EnvLookup = std::function<std::optional<std::string>(const std::string& name)>;
 // The process environment (empty values count as unset).

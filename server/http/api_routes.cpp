@@ -164,7 +164,7 @@ nlohmann::json status_json(const BenchStatus& s) {
 }
 
 std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
-                            const std::optional<WsCounts>& ws) {
+                            const std::optional<WsCounts>& ws, const std::optional<ConnectionCounts>& connections) {
   std::ostringstream o;
   auto gauge = [&](const char* name, const char* help, double v) {
     o << "# HELP " << name << " " << help << "\n# TYPE " << name << " gauge\n" << name << " " << v << "\n";
@@ -188,6 +188,11 @@ std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint6
     << "synbench_loop_overruns_total " << s.overruns << "\n";
   o << "# HELP synbench_http_requests_total HTTP requests answered, by status.\n# TYPE synbench_http_requests_total counter\n";
   for (const auto& [code, n] : http_by_status) o << "synbench_http_requests_total{status=\"" << code << "\"} " << n << "\n";
+  if (connections) {
+    gauge("synbench_http_connections", "HTTP and WebSocket connections open.", static_cast<double>(connections->open));
+    o << "# HELP synbench_http_connections_evicted_total Connections closed to make room for a new one (the least trusted, oldest).\n"
+      << "# TYPE synbench_http_connections_evicted_total counter\nsynbench_http_connections_evicted_total " << connections->evicted << "\n";
+  }
   if (ws) {
     gauge("synbench_ws_clients", "WebSocket clients connected.", static_cast<double>(ws->clients));
     o << "# HELP synbench_ws_dropped_total WebSocket clients dropped for not reading (queue bound or write stall).\n"
@@ -218,7 +223,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
               [bench, metrics](const Request&) {
                 Response r;
                 r.content_type = "text/plain; version=0.0.4";
-                r.body = prometheus_text(bench->snapshot()->status, metrics->by_status(), metrics->ws());
+                r.body = prometheus_text(bench->snapshot()->status, metrics->by_status(), metrics->ws(), metrics->connections());
                 return r;
               }});
   router.add({"GET", "/api/bench/status", Role::viewer,

@@ -30,6 +30,12 @@ struct WsCounts {
   std::uint64_t dropped = 0;
 };
 
+// Open HTTP and WebSocket connections, and those closed to make room for others.
+struct ConnectionCounts {
+  std::size_t open = 0;
+  std::uint64_t evicted = 0;
+};
+
 class HttpMetrics {
  public:
   void count(int status);
@@ -44,11 +50,22 @@ class HttpMetrics {
     if (!ws_source_) return std::nullopt;
     return ws_source_();
   }
+  // The server's connection counts, once it exists.
+  void set_connection_source(std::function<ConnectionCounts()> source) {
+    std::lock_guard lock(mutex_);
+    connection_source_ = std::move(source);
+  }
+  std::optional<ConnectionCounts> connections() const {
+    std::lock_guard lock(mutex_);
+    if (!connection_source_) return std::nullopt;
+    return connection_source_();
+  }
 
  private:
   mutable std::mutex mutex_;
   std::map<int, std::uint64_t> by_status_;
   std::function<WsCounts()> ws_source_;
+  std::function<ConnectionCounts()> connection_source_;
 };
 
 // One operator commands the bench at a time. The first operator command claims the lock; another
@@ -119,6 +136,7 @@ Response status_response(const app::StatusSnapshot& s);
 // The supervisor's phase as the API names it: "normal", "stopping_load", ... "estopped".
 const char* phase_name(bench::SafetyPhase p);
 std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
-                            const std::optional<WsCounts>& ws = std::nullopt);
+                            const std::optional<WsCounts>& ws = std::nullopt,
+                            const std::optional<ConnectionCounts>& connections = std::nullopt);
 
 }  // namespace synbench::http

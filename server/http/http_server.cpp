@@ -10,6 +10,8 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket/rfc6455.hpp>
 
+#include "server/http/connection_registry.hpp"
+#include "server/http/sign_in_log.hpp"
 #include "server/http/static_files.hpp"
 #include "server/http/ws_hub.hpp"
 #include "server/http/ws_session.hpp"
@@ -24,10 +26,12 @@ using tcp = net::ip::tcp;
 std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_t port) {
   const std::string p = ":" + std::to_string(port);
   std::set<std::string> out;
-  const bool v6 = listen_host.find(':') != std::string::npos;
-  out.insert((v6 ? "[" + listen_host + "]" : listen_host) + p);
   boost::system::error_code ec;
   const auto addr = net::ip::make_address(listen_host, ec);
+  // 0.0.0.0 or :: names no host a client can reach: the names come from --allow-host.
+  if (!ec && addr.is_unspecified()) return out;
+  const bool v6 = listen_host.find(':') != std::string::npos;
+  out.insert((v6 ? "[" + listen_host + "]" : listen_host) + p);
   if (listen_host == "localhost" || (!ec && addr.is_loopback()))
     for (const char* h : {"localhost", "127.0.0.1", "[::1]"}) out.insert(std::string(h) + p);
   return out;
@@ -56,7 +60,7 @@ struct HttpServer::Shared {
   std::vector<std::string> extra_hosts;
   std::set<std::string> origins;
   std::atomic<bool> closing{false};
-  std::atomic<std::size_t> connections{0};
+  std::shared_ptr<ConnectionRegistry> registry = std::make_shared<ConnectionRegistry>();
 };
 
 namespace {
@@ -79,22 +83,25 @@ bool routed(const std::string& path) {
   return path == "/api" || path.rfind("/api/", 0) == 0 || path == "/metrics";
 }
 
-// Counts a connection handed over to a WebSocket session for as long as that session lives.
-struct ConnectionSlot {
-  explicit ConnectionSlot(std::shared_ptr<HttpServer::Shared> s) : shared(std::move(s)) { ++shared->connections; }
-  ~ConnectionSlot() { --shared->connections; }
-  std::shared_ptr<HttpServer::Shared> shared;
-};
+Trust trust_of(const std::optional<Identity>& who) {
+  if (!who) return Trust::none;
+  return who->role == Role::operator_ ? Trust::operator_ : who->role == Role::viewer ? Trust::viewer : Trust::none;
+}
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
   Session(tcp::socket&& socket, std::shared_ptr<HttpServer::Shared> shared)
-      : stream_(std::move(socket)), shared_(std::move(shared)) {
-    ++shared_->connections;
-  }
-  ~Session() { --shared_->connections; }
+      : stream_(std::move(socket)), shared_(std::move(shared)) {}
 
-  void run() {
+  // Registers the connection (its client's address) and starts reading.
+  void run(const std::string& client) {
+    client_ = client;
+    const auto id = shared_->registry->add(client, [weak = weak_from_this(), ex = stream_.get_executor()] {
+      net::post(ex, [weak] {
+        if (auto self = weak.lock()) self->evict();
+      });
+    });
+    slot_ = std::make_shared<ConnectionSlot>(shared_->registry, id);
     net::dispatch(stream_.get_executor(), beast::bind_front_handler(&Session::do_read, shared_from_this()));
   }
 
@@ -107,11 +114,20 @@ class Session : public std::enable_shared_from_this<Session> {
   }
 
  private:
+  // Made room for another connection: the read in flight ends with operation_aborted.
+  void evict() {
+    beast::error_code ec;
+    stream_.socket().shutdown(tcp::socket::shutdown_both, ec);
+    stream_.socket().close(ec);
+  }
+
   void do_read() {
     parser_.emplace();
     parser_->body_limit(shared_->limits.max_body_bytes);
     parser_->header_limit(static_cast<std::uint32_t>(shared_->limits.max_header_bytes));
-    stream_.expires_after(std::chrono::milliseconds(static_cast<long>(shared_->limits.read_timeout_s * 1000)));
+    // A peer that has never shown a token gets little time: trickling bytes buys it nothing.
+    const double timeout_s = trust_ == Trust::none ? shared_->limits.unauthenticated_timeout_s : shared_->limits.read_timeout_s;
+    stream_.expires_after(std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
     bhttp::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&Session::on_read, shared_from_this()));
   }
 
@@ -134,6 +150,16 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void handle(bhttp::request<bhttp::string_body> req) {
     const bool keep_alive = req.keep_alive() && !shared_->closing;
+    if (req.count(bhttp::field::authorization)) {
+      const auto a = req[bhttp::field::authorization];
+      const auto who = shared_->router.identify(std::string_view(a.data(), a.size()));
+      if (!who) log_failed_sign_in(client_, std::string(req.method_string()) + " " + std::string(req.target().substr(0, 80)));
+      const Trust t = trust_of(who);
+      if (static_cast<int>(t) > static_cast<int>(trust_)) {
+        trust_ = t;
+        slot_->trust(t);
+      }
+    }
     const std::string host(req[bhttp::field::host]);
     const std::string method(req.method_string());
     const std::string target(req.target());
@@ -198,8 +224,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
   // The connection leaves this session for a WebSocket session, which answers 101 itself.
   void upgrade(bhttp::request<bhttp::string_body> req) {
-    auto slot = std::make_shared<ConnectionSlot>(shared_);
-    std::make_shared<WsSession>(stream_.release_socket(), shared_->hub, std::move(slot))->run(std::move(req));
+    std::make_shared<WsSession>(stream_.release_socket(), shared_->hub, std::move(slot_))->run(std::move(req));
   }
 
   void send_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
@@ -245,6 +270,9 @@ class Session : public std::enable_shared_from_this<Session> {
   beast::flat_buffer buffer_;
   std::shared_ptr<HttpServer::Shared> shared_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+  std::shared_ptr<ConnectionSlot> slot_;  // empty for a connection refused at the door
+  Trust trust_ = Trust::none;
+  std::string client_;  // the peer's address
   bool draining_ = false;
   std::size_t drained_ = 0;
   std::array<char, 16384> discard_{};
@@ -282,10 +310,14 @@ class HttpServer::Listener : public std::enable_shared_from_this<HttpServer::Lis
       if (ec == net::error::operation_aborted) return;
       fail(ec, "accept");
     } else {
-      const bool over = shared_->connections >= shared_->limits.max_connections;
+      beast::error_code ep;
+      const auto remote = socket.remote_endpoint(ep);
+      const std::string client = ep ? std::string("?") : remote.address().to_string();
+      const bool room = shared_->registry->make_room(client, shared_->limits.max_connections,
+                                                     shared_->limits.max_connections_per_client);
       auto session = std::make_shared<Session>(std::move(socket), shared_);
-      if (over) session->refuse();
-      else session->run();
+      if (room) session->run(client);
+      else session->refuse();
     }
     if (acceptor_.is_open()) do_accept();
   }
@@ -328,6 +360,9 @@ void HttpServer::set_websocket(std::shared_ptr<WsHub> hub, std::vector<std::stri
   shared_->hub = std::move(hub);
   shared_->extra_origins = std::move(extra_origins);
 }
+
+std::size_t HttpServer::connections() const { return shared_->registry->size(); }
+std::uint64_t HttpServer::evicted() const { return shared_->registry->evicted(); }
 
 void HttpServer::close() {
   shared_->closing = true;

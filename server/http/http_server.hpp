@@ -29,7 +29,12 @@ struct ServerLimits {
   std::size_t max_body_bytes = 64 * 1024;
   std::size_t max_header_bytes = 8 * 1024;
   double read_timeout_s = 15;  // for one whole request, and for idling between requests
-  std::size_t max_connections = 64;  // beyond this, a new connection gets 503 and is closed
+  // Until a connection has shown a valid token: a slow or silent peer is cut this soon.
+  double unauthenticated_timeout_s = 5;
+  // Beyond either, the oldest least trusted connection below an operator's is closed to make
+  // room (connection_registry.hpp); only when operators hold them all is the new one refused.
+  std::size_t max_connections = 64;
+  std::size_t max_connections_per_client = 48;  // one client address's share
 };
 
 // Host header values accepted for a server listening on host:port: "host:port", and for a
@@ -62,6 +67,9 @@ class HttpServer {
   // of `extra_origins` (without a call, /ws is 404).
   void set_websocket(std::shared_ptr<WsHub> hub, std::vector<std::string> extra_origins);
   std::uint16_t port() const { return port_; }
+  // Open connections, and how many were closed to make room for others.
+  std::size_t connections() const;
+  std::uint64_t evicted() const;
   // Stops accepting; open sessions end after their current request.
   void close();
 

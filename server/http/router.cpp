@@ -111,6 +111,14 @@ bool match_pattern(std::string_view pattern, std::string_view path, std::map<std
 
 void Router::add(Route route) { routes_.push_back(std::move(route)); }
 
+std::optional<Identity> Router::identify(std::string_view authorization) const {
+  const std::size_t sp = authorization.find(' ');
+  if (sp == std::string_view::npos || lower(authorization.substr(0, sp)) != "bearer" || !auth_) return std::nullopt;
+  std::string_view token = authorization.substr(sp + 1);
+  while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
+  return auth_(token);
+}
+
 Response Router::dispatch(const std::string& method, const std::string& target, std::string_view authorization,
                           std::string body) const {
   auto answer = std::make_shared<std::promise<Response>>();
@@ -152,17 +160,8 @@ void Router::dispatch_async(const std::string& method, const std::string& target
 
   // The token is checked whenever one is given, so a bad token is reported even on open routes
   // only when they need one; the token itself never appears in a message.
-  std::optional<Identity> caller;
-  bool token_given = false;
-  if (!authorization.empty()) {
-    token_given = true;
-    const std::size_t sp = authorization.find(' ');
-    if (sp != std::string_view::npos && lower(authorization.substr(0, sp)) == "bearer") {
-      std::string_view token = authorization.substr(sp + 1);
-      while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
-      if (auth_) caller = auth_(token);
-    }
-  }
+  const bool token_given = !authorization.empty();
+  const std::optional<Identity> caller = identify(authorization);
   if (route->role != Role::anyone) {
     auto challenge = [](Response r) {
       r.headers.emplace_back("WWW-Authenticate", "Bearer realm=\"synbench\"");

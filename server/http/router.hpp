@@ -89,6 +89,9 @@ class Router {
   Response dispatch(const std::string& method, const std::string& target,
                     std::string_view authorization, std::string body) const;
 
+  // Who an Authorization header ("Bearer TOKEN") names; nullopt for none or an unknown token.
+  std::optional<Identity> identify(std::string_view authorization) const;
+
   // OpenAPI 3.0 document generated from the table.
   nlohmann::json openapi(const std::string& title, const std::string& version) const;
 

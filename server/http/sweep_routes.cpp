@@ -1,6 +1,7 @@
 // POST /api/sweeps; GET /api/sweeps, /api/sweeps/{id}, /api/sweeps/{id}/points; see sweep_routes.hpp, docs/api.md.
 #include "server/http/sweep_routes.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <string>
@@ -78,9 +79,32 @@ Response db_error(const db::Error& e) {
   return error_response(500, "database", e.message);
 }
 
+// The calling thread's own connection to the store at `path`: the worker's reads never share
+// the io thread's connection (a SQLite connection stays with one thread; WAL lets both read).
+db::Store* thread_store(const std::filesystem::path& path, Response& error) {
+  thread_local std::map<std::filesystem::path, db::Store> stores;
+  if (const auto it = stores.find(path); it != stores.end()) return &it->second;
+  auto opened = db::Store::open(path);
+  if (!opened) {
+    error = db_error(opened.error());
+    return nullptr;
+  }
+  return &stores.emplace(path, std::move(*opened)).first->second;
+}
+
+// The plan's points before speed restrictions: what its estimate costs.
+std::size_t size_bound(const bench::SweepPlan& p) {
+  const std::size_t pairs = p.operating_points.empty() ? p.speeds_rpm.size() * p.loads_Nm.size() : p.operating_points.size();
+  return pairs * std::max<std::size_t>(1, p.angles_deg.size()) * std::max<std::size_t>(1, p.configurations.size());
+}
+
+// A viewer may estimate plans up to this size; an operator up to the plan parser's own limit.
+constexpr std::size_t kViewerEstimatePoints = 100000;
+
 }  // namespace
 
-void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, std::filesystem::path db_path,
+void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, Worker& worker,
+                      std::filesystem::path db_path,
                       nlohmann::ordered_json bench_config) {
   db::Store* db = &store;
   BenchRuntime* runtime = &bench;
@@ -156,14 +180,17 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 return json_response(200, sweep_json(*s, true));
               }});
   router.add({"GET", "/api/sweeps/{id}/points", Role::viewer,
-              "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv.", [db](const Request& req) {
+              "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv.",
+              worker.offload([db_path](const Request& req) {
                 Response err;
                 const auto id = sweep_id(req, err);
                 if (!id) return err;
                 const auto format = format_of(req, err);
                 if (!format) return err;
-                if (auto s = db->get_sweep(*id); !s) return db_error(s.error());
-                auto rows = db->points(*id);
+                db::Store* own = thread_store(db_path, err);
+                if (!own) return err;
+                if (auto s = own->get_sweep(*id); !s) return db_error(s.error());
+                auto rows = own->points(*id);
                 if (!rows) return db_error(rows.error());
                 Response r;
                 if (*format == "csv") {
@@ -173,16 +200,18 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   r.body = db::points_to_json(*rows).dump();
                 }
                 return r;
-              }});
+              })});
   router.add({"GET", "/api/sweeps/{id}/analysis", Role::viewer,
               "Analysis of a sweep's stored points (docs/analysis.md): JSON, or the curves as CSV with ?format=csv; "
               "?reference=ESTIMATOR/PWM (default encoder/capwm) for the deltas.",
-              [db](const Request& req) {
+              worker.offload([db_path](const Request& req) {
                 Response err;
                 const auto id = sweep_id(req, err);
                 if (!id) return err;
                 const auto format = format_of(req, err);
                 if (!format) return err;
+                db::Store* own = thread_store(db_path, err);
+                if (!own) return err;
                 bench::AnalysisOptions options;
                 if (req.query.count("reference")) {
                   const auto ref = parse_configuration_label(req.query.at("reference"));
@@ -191,8 +220,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                                                                 "' is not ESTIMATOR/PWM (e.g. encoder/capwm)");
                   options.reference = *ref;
                 }
-                if (auto s = db->get_sweep(*id); !s) return db_error(s.error());
-                auto rows = db->points(*id);
+                if (auto s = own->get_sweep(*id); !s) return db_error(s.error());
+                auto rows = own->points(*id);
                 if (!rows) return db_error(rows.error());
                 std::vector<bench::PointRecord> records;
                 records.reserve(rows->size());
@@ -206,7 +235,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   r.body = bench::to_json(analysis).dump();
                 }
                 return r;
-              }});
+              })});
   router.add({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
               [](const Request&) {
                 nlohmann::json out = nlohmann::json::array();
@@ -225,17 +254,20 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               }});
   router.add({"POST", "/api/sweeps/estimate", Role::viewer,
               "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
-              [](const Request& req) {
+              worker.offload([](const Request& req) {
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return *r;
                 auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
+                if (req.caller != Role::operator_ && size_bound(*plan.plan) > kViewerEstimatePoints)
+                  return error_response(413, "too_large", "a viewer may estimate plans of at most " +
+                                                              std::to_string(kViewerEstimatePoints) + " points");
                 const auto e = bench::estimate(*plan.plan);
                 nlohmann::json out = nlohmann::json::parse(bench::to_json(e).dump());
                 out["duration_s"] = e.bench_time_s;
                 out["plan"] = nlohmann::json::parse(bench::to_json(*plan.plan).dump());
                 return json_response(200, out);
-              },
+              }),
               nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
 }
 

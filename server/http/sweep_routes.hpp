@@ -9,12 +9,16 @@
 #include "db/store.hpp"
 #include "server/http/api_routes.hpp"
 #include "server/http/router.hpp"
+#include "server/http/worker.hpp"
 
 namespace synbench::http {
 
 // `bench_config`: the twin config in use, stored with each created sweep. `db_path`: the
 // store's file, which the bench thread opens for the sweep it runs.
-void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, std::filesystem::path db_path,
+// The estimate, a sweep's points and its analysis run on `worker` (their own store connection
+// there), off the io thread.
+void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, Worker& worker,
+                      std::filesystem::path db_path,
                       nlohmann::ordered_json bench_config);
 
 }  // namespace synbench::http

@@ -30,7 +30,7 @@ struct WsLimits {
   std::size_t max_queue_messages = 256;            // per session; beyond, the client is dropped
   std::size_t max_queue_bytes = 1 << 20;           // likewise
   std::chrono::milliseconds write_stall{5000};     // one write in flight longer: dropped
-  std::chrono::milliseconds auth_timeout{10000};   // for the first message, {"op":"auth"}
+  std::chrono::milliseconds auth_timeout{5000};    // for the first message, {"op":"auth"}
   // The kernel's send buffer of a session's socket. Bounded so a reader that stalls fills it in
   // seconds and the stall is seen; autotuned it could absorb minutes of telemetry.
   int socket_send_buffer_bytes = 64 * 1024;

@@ -1,6 +1,8 @@
 // One /ws session: the protocol and the bounded write queue; see ws_session.hpp, docs/api.md.
 #include "server/http/ws_session.hpp"
 
+#include "server/http/sign_in_log.hpp"
+
 #include <cmath>
 #include <iostream>
 #include <set>
@@ -49,7 +51,7 @@ std::string fmt(double v) {
 
 }  // namespace
 
-WsSession::WsSession(tcp::socket&& socket, std::shared_ptr<WsHub> hub, std::shared_ptr<void> slot)
+WsSession::WsSession(tcp::socket&& socket, std::shared_ptr<WsHub> hub, std::shared_ptr<ConnectionSlot> slot)
     : ws_(std::move(socket)), hub_(std::move(hub)), slot_(std::move(slot)), auth_timer_(ws_.get_executor()) {}
 
 WsSession::~WsSession() {
@@ -62,8 +64,16 @@ void WsSession::run(beast::http::request<beast::http::string_body> req) {
   beast::error_code ec;
   sock.set_option(tcp::no_delay(true), ec);  // a telemetry frame goes out now, not after an ACK
   sock.set_option(net::socket_base::send_buffer_size(lim.socket_send_buffer_bytes), ec);
+  if (slot_)
+    slot_->set_closer([weak = weak_from_this(), ex = ws_.get_executor()] {
+      net::post(ex, [weak] {
+        if (auto self = weak.lock()) self->evict();
+      });
+    });
   auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
   timeouts.keep_alive_pings = true;  // a silent peer is pinged; one that never answers is closed
+  // The closing handshake of a refused peer that does not read must not hold its slot for long.
+  timeouts.handshake_timeout = lim.auth_timeout;
   ws_.set_option(timeouts);
   websocket::permessage_deflate pmd;
   pmd.server_enable = false;
@@ -143,9 +153,15 @@ void WsSession::handle_auth(const nlohmann::json& doc) {
   if (!doc.contains("token") || !doc["token"].is_string()) return refuse("token: required, a string");
   const std::string token = doc["token"].get<std::string>();
   auto who = hub_->authenticate(token);
-  if (!who) return refuse("token: not valid");
+  if (!who) {
+    beast::error_code ec;
+    const auto peer = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
+    log_failed_sign_in(ec ? std::string("?") : peer.address().to_string(), "/ws auth");
+    return refuse("token: not valid");
+  }
   identity_ = std::move(who);
   token_ = token;
+  if (slot_) slot_->trust(identity_->role == Role::operator_ ? Trust::operator_ : Trust::viewer);
   auth_timer_.cancel();
   send(nlohmann::json{{"type", "hello"}, {"role", role_name(identity_->role)}, {"id", identity_->id}, {"version", hub_->version()}});
 }
@@ -236,6 +252,12 @@ void WsSession::deliver(std::shared_ptr<const HubTick> tick) {
 void WsSession::on_tick(const HubTick& tick) {
   if (dropped_ || closing_) return;
   const WsLimits& lim = hub_->limits();
+  // A token revoked (removed from tokens.json) ends its open sessions within a second, as it
+  // ends its HTTP requests at once.
+  if (identity_ && tick.index >= last_token_check_ + 50) {
+    last_token_check_ = tick.index;
+    if (!hub_->authenticate(token_)) return refuse("the token was revoked");
+  }
   if (writing_ && std::chrono::steady_clock::now() - write_started_ > lim.write_stall)
     return drop("one write has been in flight for more than " + std::to_string(lim.write_stall.count()) + " ms");
   if (!identity_) return;
@@ -290,6 +312,18 @@ void WsSession::close_if_due() {
                       if (e) fail(e, "close");
                     });
   }
+}
+
+void WsSession::evict() {
+  if (dropped_) return;
+  dropped_ = true;
+  beast::error_code ec;
+  auto& sock = beast::get_lowest_layer(ws_).socket();
+  sock.shutdown(tcp::socket::shutdown_both, ec);
+  sock.close(ec);
+  auth_timer_.cancel();
+  queue_.clear();
+  queued_bytes_ = 0;
 }
 
 void WsSession::drop(const std::string& reason) {

@@ -1,6 +1,6 @@
 // One /ws connection after the HTTP upgrade (the HTTP session has already checked Host and
 // Origin). Protocol (docs/api.md): the first message must be {"op":"auth","token":...} within
-// 10 s, else an `unauthorized` error and close 1008; then subscribe/unsubscribe to telemetry
+// 5 s, else an `unauthorized` error and close 1008; then subscribe/unsubscribe to telemetry
 // (at the client's rate), sweep and events, and `request`s dispatched through the REST Router
 // with the session's token, so roles, the control lock and validation are REST's own.
 // Writes: one in flight, behind a bounded queue; a client whose queue overflows or whose write
@@ -21,14 +21,16 @@
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
 
+#include "server/http/connection_registry.hpp"
 #include "server/http/ws_hub.hpp"
 
 namespace synbench::http {
 
 class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
-  // `slot` is held for the session's life (the server's connection count).
-  WsSession(boost::asio::ip::tcp::socket&& socket, std::shared_ptr<WsHub> hub, std::shared_ptr<void> slot);
+  // `slot` is the connection's registration, held for the session's life: the session raises its
+  // trust once authenticated and closes itself when the server needs the room.
+  WsSession(boost::asio::ip::tcp::socket&& socket, std::shared_ptr<WsHub> hub, std::shared_ptr<ConnectionSlot> slot);
   ~WsSession();
   // Answers the upgrade request with 101 and starts the session.
   void run(boost::beast::http::request<boost::beast::http::string_body> req);
@@ -58,10 +60,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void close_if_due();
   // Closes the socket at once: for a client that does not read.
   void drop(const std::string& reason);
+  // Closes the socket at once without counting a slow client: the server needed the room.
+  void evict();
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
   std::shared_ptr<WsHub> hub_;
-  std::shared_ptr<void> slot_;
+  std::shared_ptr<ConnectionSlot> slot_;
+  std::uint64_t last_token_check_ = 0;  // the hub tick the token was last found valid at
   boost::beast::flat_buffer buffer_;
   boost::asio::steady_timer auth_timer_;
   bool joined_ = false;

@@ -16,6 +16,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -181,6 +182,18 @@ def main():
             check(udc > 300, "serve --bench reads the emulator's DC bus over Modbus TCP (%.0f V)" % udc)
             check(stop(proc) == 0, "serve --bench: SIGTERM -> exit 0")
     stop(emu)
+
+    # The unit's hardening, as systemd itself scores it (below 4 is "OK"; 7.5 was "EXPOSED").
+    if shutil.which("systemd-analyze"):
+        with tempfile.TemporaryDirectory() as d:
+            unit = os.path.join(d, "synbench.service")
+            shutil.copy(os.path.join(ROOT, "docker", "synbench.service"), unit)
+            r = subprocess.run(["systemd-analyze", "security", "--offline=true", unit], capture_output=True, text=True)
+            m = re.search(r"Overall exposure level for synbench\.service: ([\d.]+)", r.stdout + r.stderr)
+            check(m is not None and float(m.group(1)) < 4.0,
+                  "systemd-analyze security scores synbench.service below 4 (%s)" % (m.group(1) if m else r.stderr[-200:]))
+    else:
+        print("note: systemd-analyze is absent: the unit's hardening score is not checked")
 
     if failures:
         print("%d failure(s)" % len(failures))

@@ -123,3 +123,26 @@ TEST(ServeOptions, ParsersAcceptWhatTheyShould) {
 
 }  // namespace
 }  // namespace synbench::cli
+
+namespace synbench::cli {
+namespace {
+
+// Plain HTTP beyond loopback carries bearer tokens in the clear: refused unless confirmed.
+TEST(ServeOptions, ANonLoopbackListenNeedsItsConfirmation) {
+  const auto refused = [](const std::vector<std::string>& argv) {
+    try {
+      parse_serve_options(argv, [](const std::string&) { return std::optional<std::string>(); }, "/web");
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refused({"--listen", "0.0.0.0:8080"}).find("not a loopback address"), std::string::npos);
+  EXPECT_NE(refused({"--listen", "192.0.2.7:8080"}).find("--allow-remote-plain-http"), std::string::npos);
+  EXPECT_EQ(refused({"--listen", "0.0.0.0:8080", "--allow-remote-plain-http"}), "");
+  EXPECT_EQ(refused({"--listen", "127.0.0.2:8080"}), "");
+  EXPECT_EQ(refused({"--listen", "[::1]:8080"}), "");
+}
+
+}  // namespace
+}  // namespace synbench::cli

@@ -91,6 +91,13 @@ TEST(ContentType, ByExtension) {
   EXPECT_EQ(content_type_for("a"), "application/octet-stream");
 }
 
+// A Host header naming 0.0.0.0 is no name of the daemon's: only --allow-host names pass.
+TEST(Origins, AnUnspecifiedListenAddressAllowsNoHostOfItsOwn) {
+  EXPECT_TRUE(allowed_hosts("0.0.0.0", 8080).empty());
+  EXPECT_TRUE(allowed_hosts("::", 8080).empty());
+  EXPECT_TRUE(allowed_hosts("192.0.2.7", 8080).count("192.0.2.7:8080"));
+}
+
 TEST(Origins, HttpOfEachAllowedHostAndTheExtraOnes) {
   const auto o = allowed_origins(allowed_hosts("127.0.0.1", 8080), {"http://Dash.example:5173"});
   EXPECT_TRUE(o.count("http://127.0.0.1:8080"));

@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""An operator's E-stop stays reachable while the daemon is attacked from the loopback (issue "A
+daemon no input can crash, no client can keep from its E-stop"): during each attack an operator
+opens a fresh connection and sends POST /api/bench/estop (then a reset) 20 times; every E-stop
+must answer 200 within 100 ms, the daemon must stay up, and the bench must read estopped.
+
+  slowloris  180 connections held open by a reconnecting attacker, each trickling one byte of a
+             request header every 0.5 s and never finishing it (the connection cap is 64)
+  ws-idle    60 WebSocket upgrades that never authenticate, reopened as soon as they close
+  flood      wrk -t2 -c300 on GET /api/health (skipped without wrk)
+  estimate   8 viewers and 2 operators looping POST /api/sweeps/estimate on a 10^6-point plan
+
+Prints per attack the E-stop latencies (p50, max) and how many connections the daemon closed to
+make room. usage: estop_under_attack_test.py path/to/synbench [--seconds-per-attack 6]"""
+import http.client
+import json
+import os
+import shutil
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ws_util import Daemon  # noqa: E402
+
+BIN = sys.argv[1]
+TRIALS = 20
+LIMIT_MS = 100.0
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+def request(d, method, path, token, body=None, timeout=10):
+    conn = http.client.HTTPConnection("127.0.0.1", d.port, timeout=timeout)
+    headers = {"Host": d.host, "Authorization": "Bearer " + token}
+    data = None
+    if body is not None:
+        data = json.dumps(body)
+        headers["Content-Type"] = "application/json"
+    conn.request(method, path, body=data, headers=headers)
+    r = conn.getresponse()
+    raw = r.read()
+    conn.close()
+    return r.status, raw
+
+
+class Attack:
+    """Threads that keep an attack going until stop()."""
+
+    def __init__(self):
+        self.stopping = threading.Event()
+        self.threads = []
+
+    def spawn(self, fn, n):
+        for i in range(n):
+            t = threading.Thread(target=fn, args=(i,), daemon=True)
+            t.start()
+            self.threads.append(t)
+
+    def stop(self):
+        self.stopping.set()
+        for t in self.threads:
+            t.join(timeout=10)
+
+
+def slowloris(d, attack, conns):
+    head = ("GET /api/health HTTP/1.1\r\nHost: %s\r\nX-Slow: " % d.host).encode()
+
+    def one(_):
+        while not attack.stopping.is_set():
+            try:
+                s = socket.create_connection(("127.0.0.1", d.port), timeout=2)
+                for b in head:
+                    if attack.stopping.is_set():
+                        break
+                    s.sendall(bytes([b]))
+                    time.sleep(0.5)
+                s.close()
+            except OSError:
+                time.sleep(0.05)
+
+    attack.spawn(one, conns)
+
+
+def ws_idle(d, attack, conns):
+    upgrade = ("GET /ws HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n" % d.host).encode()
+
+    def one(_):
+        while not attack.stopping.is_set():
+            try:
+                s = socket.create_connection(("127.0.0.1", d.port), timeout=2)
+                s.sendall(upgrade)
+                s.settimeout(1)
+                # Never authenticate; wait for the daemon to give up on us, then come back.
+                while not attack.stopping.is_set():
+                    try:
+                        if not s.recv(4096):
+                            break
+                    except socket.timeout:
+                        continue
+                s.close()
+            except OSError:
+                time.sleep(0.05)
+
+    attack.spawn(one, conns)
+
+
+def estimates(d, attack, viewer, operator):
+    plan = {"dimensions": {"speed_rpm": list(range(100, 1100, 1)), "load_Nm": [0.5 + 0.003 * i for i in range(1000)],
+                           "angle_deg": [50]}}
+
+    def one(i):
+        token = operator if i < 2 else viewer
+        while not attack.stopping.is_set():
+            try:
+                request(d, "POST", "/api/sweeps/estimate", token, plan, timeout=30)
+            except OSError:
+                time.sleep(0.05)
+
+    attack.spawn(one, 10)
+
+
+def measure(d, name):
+    lat = []
+    bad = []
+    for _ in range(TRIALS):
+        t0 = time.perf_counter()
+        try:
+            status, raw = request(d, "POST", "/api/bench/estop", d.operator, timeout=10)
+        except OSError as e:
+            status, raw = 0, str(e).encode()
+        ms = (time.perf_counter() - t0) * 1000
+        if status == 200:
+            lat.append(ms)
+        else:
+            bad.append("%s %s" % (status, raw[:120]))
+        try:
+            request(d, "POST", "/api/bench/reset", d.operator, timeout=10)
+        except OSError:
+            pass
+        time.sleep(0.05)
+    lat.sort()
+    worst = lat[-1] if lat else float("inf")
+    check(not bad and worst < LIMIT_MS,
+          "%s: %d/%d E-stops answered 200, p50 %.1f ms, max %.1f ms (limit %.0f ms)%s"
+          % (name, len(lat), TRIALS, statistics.median(lat) if lat else float("nan"), worst, LIMIT_MS,
+             "; refused: " + "; ".join(bad[:3]) if bad else ""))
+
+
+def main():
+    seconds = float(sys.argv[sys.argv.index("--seconds-per-attack") + 1]) if "--seconds-per-attack" in sys.argv else 6.0
+    tmp = tempfile.mkdtemp(prefix="synbench_attack_")
+    log = open(os.path.join(tmp, "serve.log"), "w")
+    d = Daemon(BIN, os.path.join(tmp, "data"))
+    # The daemon's stderr to a file: nobody may block it by not reading a pipe.
+    threading.Thread(target=lambda: shutil.copyfileobj(d.proc.stderr, log), daemon=True).start()
+    viewer = d.token("viewer")
+    try:
+        status, _ = request(d, "POST", "/api/bench/setpoints", d.operator, {"speed_rpm": 300, "angle_deg": 50})
+        check(status == 200, "setpoints before the attacks (%s)" % status)
+        measure(d, "no attack")
+        attacks = [("slowloris", lambda a: slowloris(d, a, 180)), ("ws-idle", lambda a: ws_idle(d, a, 60)),
+                   ("estimate", lambda a: estimates(d, a, viewer, d.operator))]
+        for name, start in attacks:
+            a = Attack()
+            start(a)
+            time.sleep(seconds)  # the attack in full swing
+            measure(d, name)
+            a.stop()
+        if shutil.which("wrk"):
+            wrk = subprocess.Popen(["wrk", "-t2", "-c300", "-d%ds" % int(seconds + 10), "http://%s/api/health" % d.host],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(2)
+            measure(d, "flood (wrk -c300)")
+            wrk.terminate()
+            wrk.wait()
+        else:
+            print("note: wrk is absent: the flood is not tried")
+        metrics = request(d, "GET", "/metrics", d.operator)[1].decode()
+        evicted = [line for line in metrics.splitlines() if line.startswith("synbench_http_connections_evicted_total")]
+        print("     " + (evicted[0] if evicted else "no eviction counter in /metrics"))
+        status, raw = request(d, "GET", "/api/bench/status", d.operator)
+        check(status == 200 and d.proc.poll() is None, "the daemon is up and answers after the attacks")
+    finally:
+        code, _ = d.stop(read_stderr=False)
+        log.close()
+        check(code == 0, "SIGTERM -> exit 0 (%s)" % code)
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("all checks passed" if not failures else "%d checks FAILED" % len(failures))
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
