@@ -382,9 +382,14 @@ void BenchRuntime::sweep_action(std::int64_t id, std::string action, Done done) 
 void BenchRuntime::finish_sweep(double now_s) {
   const auto p = sweep_->engine().progress();
   const auto state = sweep_->engine().state();
-  last_sweep_ = SweepInfo{sweep_->id(), std::string(bench::name(state)), p.done, p.total, sweep_->engine().error()};
-  if (auto e = sweep_->finish()) event("sweep", "recording the final state failed: " + *e);
-  event("sweep", "sweep " + std::to_string(sweep_->id()) + " " + std::string(bench::name(state)));
+  const std::string& error = sweep_->engine().error();
+  const std::string which = "sweep " + std::to_string(sweep_->id());
+  last_sweep_ = SweepInfo{sweep_->id(), std::string(bench::name(state)), p.done, p.total, error};
+  // A sweep's store failure (a lost file, a full disk) is a fault an operator must see in the
+  // journal, with the store's message, as the supervisor's trips.
+  if (auto e = sweep_->finish()) event("fault", which + ": recording its final state failed: " + *e);
+  const bool faulted = state == bench::SweepState::faulted;
+  event(faulted ? "fault" : "sweep", which + " " + std::string(bench::name(state)) + (error.empty() ? "" : ": " + error));
   sweep_.reset();
   sweep_store_.reset();
   if (!supervisor_->tripped()) supervisor_->expect_stopped(now_s);

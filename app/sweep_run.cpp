@@ -9,11 +9,15 @@ class SweepRun::Sink final : public bench::SweepSink {
   std::error_code store_point(std::size_t index, const bench::PointRecord& r) override {
     const auto st = store_.insert_point(id_, static_cast<std::int64_t>(index), r);
     if (!st) {
-      event("fault", "storing point " + std::to_string(index) + " failed: " + st.error().message);
+      // The engine faults the sweep with this message and records the fault event itself.
+      last_failure_ = st.error().message;
       return st.code();
     }
     if (observer_) observer_->store_point(index, r);
     return {};
+  }
+  std::string failure_message(std::error_code ec) const override {
+    return last_failure_.empty() ? ec.message() : last_failure_;
   }
   void event(const std::string& kind, const std::string& message) override {
     const auto k = kind == "fault" || kind == "alarm" ? db::EventKind::fault
@@ -30,6 +34,7 @@ class SweepRun::Sink final : public bench::SweepSink {
   db::Store& store_;
   std::int64_t id_;
   bench::SweepSink* observer_;
+  std::string last_failure_;
 };
 
 SweepRun::SweepRun(drivers::BenchDevices devices, bench::SafetySupervisor& supervisor, db::Store& store, std::int64_t id,

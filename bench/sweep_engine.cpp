@@ -119,7 +119,7 @@ void SweepEngine::finish_point(double /*now_s*/) {
   }
   const PointRecord& r = proc->record();
   if (const auto ec = sink_.store_point(n.point.index, r)) {
-    error_ = "storing point " + std::to_string(n.point.index) + " failed: " + ec.message();
+    error_ = "storing point " + std::to_string(n.point.index) + " failed: " + sink_.failure_message(ec);
     sink_.event("fault", error_);
     begin_stop(SweepState::faulted, now_);
     return;

@@ -43,6 +43,9 @@ class SweepSink {
   virtual ~SweepSink() = default;
   // Called once per measured point; must make it durable before returning.
   virtual std::error_code store_point(std::size_t index, const PointRecord& record) = 0;
+  // The sentence for store_point's last failure `ec`: a store knows more than its code (which
+  // file, SQLite's own text), and the sweep faults with this.
+  virtual std::string failure_message(std::error_code ec) const { return ec.message(); }
   virtual void event(const std::string& /*kind*/, const std::string& /*message*/) {}
   virtual void progress(const SweepProgress& /*p*/) {}
 };

@@ -21,6 +21,9 @@ class Category final : public std::error_category {
       case errc::invalid_argument: return "invalid argument";
       case errc::invalid_transition: return "sweep state change refused";
       case errc::bad_record: return "stored row cannot be read back as a record";
+      case errc::file_lost: return "the database file was deleted or replaced while open";
+      case errc::disk_full: return "disk full";
+      case errc::read_only: return "the database cannot be written (read-only)";
     }
     return "unknown database error";
   }
@@ -31,6 +34,21 @@ class Category final : public std::error_category {
 const std::error_category& error_category() noexcept {
   static const Category category;
   return category;
+}
+
+bool is_storage_failure(std::error_code ec) noexcept {
+  if (ec.category() != error_category()) return false;
+  switch (static_cast<errc>(ec.value())) {
+    case errc::sqlite:
+    case errc::busy:
+    case errc::io:
+    case errc::corrupt:
+    case errc::bad_record:
+    case errc::file_lost:
+    case errc::disk_full:
+    case errc::read_only: return true;
+    default: return false;
+  }
 }
 
 }  // namespace synbench::db

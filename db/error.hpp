@@ -26,7 +26,14 @@ enum class errc {
   invalid_argument,    // e.g. a point index outside the sweep's plan, an empty sweep name
   invalid_transition,  // a sweep state change the store refuses (see docs/database.md)
   bad_record,          // a stored row cannot be turned back into a record (unknown estimator...)
+  file_lost,           // the open file was deleted or replaced at its path: writes would vanish
+  disk_full,           // SQLITE_FULL: no space left (or the connection's max_page_count)
+  read_only,           // the file, its directory or its file system cannot be written
 };
+
+// Whether a failure is the database's (the file, the disk, SQLite) rather than the caller's
+// (an unknown sweep, a duplicate point, a refused state change): these are worth a log line.
+bool is_storage_failure(std::error_code ec) noexcept;
 
 const std::error_category& error_category() noexcept;
 

@@ -104,10 +104,20 @@ constexpr std::string_view kSchemaV3 = R"sql(
 ALTER TABLE points ADD COLUMN lock_lost INTEGER NOT NULL DEFAULT 0 CHECK (lock_lost IN (0, 1));
 )sql";
 
+// Version 4: the process driving a running sweep (host, pid, and its start: boot id and start
+// time), so a daemon starting later can tell a sweep left running by a crash from one another
+// process runs now. NULL when not running, and on sweeps of older versions.
+constexpr std::string_view kSchemaV4 = R"sql(
+ALTER TABLE sweeps ADD COLUMN owner_host TEXT;
+ALTER TABLE sweeps ADD COLUMN owner_pid INTEGER;
+ALTER TABLE sweeps ADD COLUMN owner_start TEXT;
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
     Migration{3, "points: lock_lost", kSchemaV3},
+    Migration{4, "sweeps: owner_host, owner_pid, owner_start", kSchemaV4},
 };
 
 struct Header {

@@ -26,10 +26,10 @@ errc classify(int rc) noexcept {
     case SQLITE_DONE: return errc::ok;
     case SQLITE_BUSY:
     case SQLITE_LOCKED: return errc::busy;
+    case SQLITE_FULL: return errc::disk_full;
+    case SQLITE_READONLY: return errc::read_only;
     case SQLITE_IOERR:
-    case SQLITE_FULL:
     case SQLITE_CANTOPEN:
-    case SQLITE_READONLY:
     case SQLITE_PERM: return errc::io;
     case SQLITE_CORRUPT:
     case SQLITE_NOTADB: return errc::corrupt;
@@ -37,26 +37,47 @@ errc classify(int rc) noexcept {
   }
 }
 
-Error sqlite_error(sqlite3* db, int rc, std::string_view what) {
+namespace {
+
+// What an operator should read first, before SQLite's own sentence: SQLite says "database or
+// disk is full" for both SQLITE_FULL causes and "attempt to write a readonly database" for
+// several read-only causes.
+std::string_view plain_words(int rc) noexcept {
+  switch (rc & 0xff) {
+    case SQLITE_FULL: return "disk full: ";
+    case SQLITE_READONLY: return "read-only: ";
+    case SQLITE_IOERR: return "I/O error: ";
+    case SQLITE_CORRUPT: return "database damaged: ";
+    default: return "";
+  }
+}
+
+Error describe(int rc, std::string_view what, const char* sqlite_message) {
   std::string msg(what);
   msg += ": ";
-  // The connection's message is the specific one ("UNIQUE constraint failed: ..."); without a
-  // connection (open failed early) only the generic text of the code is known.
-  msg += db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+  msg += plain_words(rc);
+  msg += sqlite_message;
+  // The extended code (sqlite3_extended_result_codes is on) tells e.g. SQLITE_IOERR_FSYNC (1034)
+  // from SQLITE_IOERR_WRITE (778).
   msg += " (SQLite code " + std::to_string(rc) + ")";
   return {make_error_code(classify(rc)), std::move(msg)};
+}
+
+}  // namespace
+
+Error sqlite_error(sqlite3* db, int rc, std::string_view what) {
+  // The connection's message is the specific one ("UNIQUE constraint failed: ..."); without a
+  // connection (open failed early) only the generic text of the code is known.
+  return describe(rc, what, db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
 }
 
 Status exec(sqlite3* db, const char* sql, std::string_view what) {
   char* err = nullptr;
   const int rc = sqlite3_exec(db, sql, nullptr, nullptr, &err);
   if (rc == SQLITE_OK) return {};
-  std::string msg(what);
-  msg += ": ";
-  msg += err ? err : sqlite3_errstr(rc);
-  msg += " (SQLite code " + std::to_string(rc) + ")";
+  Error e = describe(rc, what, err ? err : sqlite3_errstr(rc));
   sqlite3_free(err);
-  return Error{make_error_code(classify(rc)), std::move(msg)};
+  return e;
 }
 
 Result<Statement> Statement::prepare(sqlite3* db, std::string_view sql) {

@@ -7,7 +7,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "db/file_watch.hpp"
 #include "db/migrations.hpp"
+#include "db/owner.hpp"
 #include "db/point_columns.hpp"
 #include "db/sqlite.hpp"
 
@@ -188,22 +190,53 @@ Result<drivers::TruthWindow> parse_truth(const std::string& text) {
 struct Store::Impl {
   sqlite3* db = nullptr;
   std::filesystem::path path;
+  detail::FileWatch watch;
+  detail::ProcessOwner me = detail::this_process();
+  std::function<void(const Error&)> on_error;
   detail::TransactionStatements tx;
   Statement insert_sweep, insert_event, sweep_for_update, update_sweep_state, select_sweep,
       select_sweeps, sweep_total, sweep_exists, insert_point, select_points, select_indices,
-      select_events_of_sweep, select_events_all;
+      select_events_of_sweep, select_events_all, select_running;
 
   ~Impl() {
     // Statements first: sqlite3_close_v2 would otherwise defer the close until they are gone.
     tx = {};
     for (auto* s : {&insert_sweep, &insert_event, &sweep_for_update, &update_sweep_state, &select_sweep,
                     &select_sweeps, &sweep_total, &sweep_exists, &insert_point, &select_points,
-                    &select_indices, &select_events_of_sweep, &select_events_all})
+                    &select_indices, &select_events_of_sweep, &select_events_all, &select_running})
       *s = Statement();
     sqlite3_close_v2(db);
   }
 
-  Error fail(int rc, std::string_view what) const { return detail::sqlite_error(db, rc, what); }
+  // A failure of the storage goes to the log hook on its way to the caller.
+  Error report(Error e) const {
+    if (on_error && is_storage_failure(e.code)) on_error(e);
+    return e;
+  }
+  // SQLite's failure, naming the file and what we tried.
+  Error fail(int rc, std::string_view what) const {
+    return report(detail::sqlite_error(db, rc, path.string() + ": " + std::string(what)));
+  }
+  Error named(const Error& e, std::string_view what) const {
+    return report(Error{e.code, path.string() + ": " + std::string(what) + ": " + e.message});
+  }
+  // The file (and its WAL) at the path is still the one open: else errc::file_lost.
+  Status check_file() {
+    if (auto s = watch.check(); !s) return report(s.error());
+    return {};
+  }
+  // BEGIN IMMEDIATE, refused before any work when the file is lost.
+  Status begin(Transaction& t, std::string_view what) {
+    if (auto s = check_file(); !s) return s;
+    if (auto s = t.begin(); !s) return named(s.error(), what);
+    return {};
+  }
+  // COMMIT, then the check again: a success means the data is in the file at the path, not in
+  // one deleted while the commit ran.
+  Status commit(Transaction& t, std::string_view what) {
+    if (auto s = t.commit(); !s) return named(s.error(), what);
+    return check_file();
+  }
 
   Status prepare_all() {
     const std::pair<Statement*, std::string> all[] = {
@@ -216,7 +249,7 @@ struct Store::Impl {
          "FROM sweeps WHERE id = ?1"},
         {&update_sweep_state,
          "UPDATE sweeps SET state = ?, started_at = ?, finished_at = ?, "
-         "last_error = coalesce(?, last_error) WHERE id = ?"},
+         "last_error = coalesce(?, last_error), owner_host = ?, owner_pid = ?, owner_start = ? WHERE id = ?"},
         {&select_sweep, std::string(kSweepColumns) + " WHERE s.id = ?"},
         {&select_sweeps, std::string(kSweepColumns) + " ORDER BY s.id"},
         {&sweep_total, "SELECT total_points FROM sweeps WHERE id = ?"},
@@ -227,6 +260,8 @@ struct Store::Impl {
         {&select_events_of_sweep,
          "SELECT id, sweep_id, at, kind, message FROM events WHERE sweep_id = ? ORDER BY id"},
         {&select_events_all, "SELECT id, sweep_id, at, kind, message FROM events ORDER BY id"},
+        {&select_running,
+         "SELECT id, owner_host, owner_pid, owner_start FROM sweeps WHERE state = 'running' ORDER BY id"},
     };
     for (const auto& [st, sql] : all) {
       auto p = Statement::prepare(db, sql);
@@ -288,6 +323,57 @@ struct Store::Impl {
     if (id) *id = sqlite3_last_insert_rowid(db);
     return {};
   }
+
+  // The body of set_sweep_state, inside the caller's transaction. A sweep going running records
+  // this process as its owner; leaving running clears it.
+  Status change_state_in_tx(std::int64_t sweep_id, SweepState state, const std::optional<std::string>& error,
+                            bool sparse_plan) {
+    SweepState from{};
+    std::optional<std::string> started_at;
+    std::int64_t total = 0, stored = 0;
+    {
+      auto& st = sweep_for_update;
+      Statement::Use use(st);
+      st.bind(1, sweep_id);
+      const int rc = st.step();
+      if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
+      if (rc != SQLITE_ROW) return fail(rc, "reading the sweep's state");
+      const auto f = parse_sweep_state(st.text(0));
+      if (!f) return make_error(errc::bad_record, "sweep " + std::to_string(sweep_id) + " has an unknown state");
+      from = *f;
+      started_at = st.opt_text(1);
+      total = st.integer(2);
+      stored = st.integer(3);
+    }
+    const std::string transition = std::string(name(from)) + " -> " + std::string(name(state));
+    if (from == SweepState::completed && state != SweepState::completed)
+      return make_error(errc::invalid_transition, transition + ": a completed sweep is final");
+    if (state == SweepState::created && from != SweepState::created)
+      return make_error(errc::invalid_transition, transition + ": a sweep cannot return to created");
+    if (state == SweepState::completed && stored < total && !sparse_plan)
+      return make_error(errc::invalid_transition, transition + ": only " + std::to_string(stored) + " of " +
+                                                      std::to_string(total) + " points are stored");
+
+    const std::string now = now_utc();
+    if (state == SweepState::running && !started_at) started_at = now;
+    const bool running = state == SweepState::running;
+    {
+      auto& st = update_sweep_state;
+      Statement::Use use(st);
+      st.bind(1, name(state));
+      st.bind(2, started_at);
+      st.bind(3, finished(state) ? std::optional<std::string>(now) : std::nullopt);
+      st.bind(4, error);
+      st.bind(5, running ? std::optional<std::string>(me.host) : std::nullopt);
+      st.bind(6, running ? std::optional<std::int64_t>(me.pid) : std::nullopt);
+      st.bind(7, running && !me.start.empty() ? std::optional<std::string>(me.start) : std::nullopt);
+      st.bind(8, sweep_id);
+      const int rc = st.step();
+      if (rc != SQLITE_DONE) return fail(rc, "changing the sweep's state");
+    }
+    const std::string message = error ? transition + ": " + *error : transition;
+    return add_event_in_tx(sweep_id, EventKind::state, message, nullptr);
+  }
 };
 
 Store::Store(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -302,12 +388,47 @@ Store::Impl& Store::impl() const {
 
 const std::filesystem::path& Store::path() const { return impl().path; }
 
+namespace {
+
+// A read-only refusal, with the places to look.
+Error read_only_error(const std::string& message) {
+  return make_error(errc::read_only, message +
+                                         "; synbench must write it (check the file's mode and owner, its directory's, "
+                                         "and whether the file system is mounted read-only)");
+}
+
+// PRAGMA quick_check: the b-trees' pages and records, without the index cross-checks of
+// integrity_check, so it stays quick on a large file. Up to 10 findings in the message.
+Status quick_check(sqlite3* db, const std::string& where) {
+  auto st = Statement::prepare(db, "PRAGMA quick_check(10)");
+  if (!st) return Error{st.error().code, where + ": quick_check: " + st.error().message};
+  std::string findings;
+  for (;;) {
+    const int rc = st->step();
+    if (rc == SQLITE_DONE) break;
+    if (rc != SQLITE_ROW) return detail::sqlite_error(db, rc, where + ": quick_check");
+    const std::string row = st->text(0);
+    if (row == "ok") continue;
+    findings += findings.empty() ? "" : "; ";
+    findings += row;
+  }
+  if (findings.empty()) return {};
+  return make_error(errc::corrupt, where + ": the file has damaged pages; PRAGMA quick_check says: " + findings);
+}
+
+}  // namespace
+
 Result<Store> Store::open(const std::filesystem::path& path, const StoreOptions& options) {
   // SQLite would take "" as a private temporary database, gone at close: never what is meant.
   if (path.empty()) return make_error(errc::invalid_argument, "the database path is empty");
   auto impl = std::make_unique<Impl>();
   impl->path = path;
   const std::string where = "opening " + path.string();
+  // A read-only refusal also says where to look.
+  const auto refuse = [&](Error e) -> Error {
+    if (e.code == errc::read_only) return read_only_error(e.message);
+    return e;
+  };
   const int rc = sqlite3_open_v2(path.c_str(), &impl->db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   if (rc != SQLITE_OK) return detail::sqlite_error(impl->db, rc, where);
   sqlite3_extended_result_codes(impl->db, 1);  // tells a UNIQUE from a FOREIGN KEY failure
@@ -317,19 +438,44 @@ Result<Store> Store::open(const std::filesystem::path& path, const StoreOptions&
   // file system without shared memory) would silently lose the durability we promise.
   {
     auto st = Statement::prepare(impl->db, "PRAGMA journal_mode = WAL");
-    if (!st) return st.error();
+    if (!st) return refuse(Error{st.error().code, where + ": " + st.error().message});
     const int step = st->step();
-    if (step != SQLITE_ROW) return impl->fail(step, where + ": setting WAL");
+    if (step != SQLITE_ROW) return refuse(detail::sqlite_error(impl->db, step, where + ": setting WAL"));
     if (st->text(0) != "wal")
       return make_error(errc::io, where + ": WAL journal not available (got \"" + st->text(0) + "\")");
   }
+  // SQLite opens a file it may not write read-only without a word (SQLITE_OPEN_READWRITE means
+  // "if possible"); every write would fail later, in the middle of a sweep.
+  if (sqlite3_db_readonly(impl->db, "main") == 1)
+    return read_only_error(where + ": SQLite could open the file only for reading");
   // synchronous=FULL: in WAL mode the WAL is fsynced at every commit, so a committed point
   // survives a power cut, not only a process crash (NORMAL would only promise the latter).
   if (auto s = detail::exec(impl->db, "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON;", where); !s)
-    return s.error();
+    return refuse(s.error());
+  // Damaged pages are refused before a migration writes into the file.
+  if (options.verify)
+    if (auto s = quick_check(impl->db, where); !s) return s.error();
   if (auto s = detail::migrate(impl->db, migrations()); !s)
-    return Error{s.error().code, where + ": " + s.error().message};
-  if (auto s = impl->prepare_all(); !s) return s.error();
+    return refuse(Error{s.error().code, where + ": " + s.error().message});
+  if (options.verify) {
+    // A committed write (the version number, rewritten as it is): the WAL and its index must be
+    // writable too, which the file's own mode does not tell.
+    const std::string probe =
+        "BEGIN IMMEDIATE; PRAGMA user_version = " + std::to_string(schema_version()) + "; COMMIT;";
+    if (auto s = detail::exec(impl->db, probe.c_str(), where + ": writing"); !s) {
+      (void)detail::exec(impl->db, "ROLLBACK", where);
+      return refuse(s.error());
+    }
+  }
+  if (options.max_page_count) {
+    const std::string sql = "PRAGMA max_page_count = " + std::to_string(*options.max_page_count);
+    if (auto s = detail::exec(impl->db, sql.c_str(), where); !s) return s.error();
+  }
+  if (auto s = impl->prepare_all(); !s) return Error{s.error().code, where + ": " + s.error().message};
+  auto watch = detail::FileWatch::pin(impl->db, path);
+  if (!watch) return Error{watch.error().code, where + ": " + watch.error().message};
+  impl->watch = std::move(*watch);
+  impl->on_error = options.on_error;
   return Store(std::move(impl));
 }
 
@@ -338,7 +484,7 @@ Result<std::int64_t> Store::create_sweep(const SweepMeta& meta) {
   if (meta.name.empty()) return make_error(errc::invalid_argument, "a sweep needs a name");
   if (meta.total_points < 0) return make_error(errc::invalid_argument, "total_points must be >= 0");
   Transaction tx(d.db, d.tx);
-  if (auto s = tx.begin(); !s) return s.error();
+  if (auto s = d.begin(tx, "creating a sweep"); !s) return s.error();
   std::int64_t id = 0;
   {
     auto& st = d.insert_sweep;
@@ -356,62 +502,73 @@ Result<std::int64_t> Store::create_sweep(const SweepMeta& meta) {
     id = sqlite3_last_insert_rowid(d.db);
   }
   if (auto s = d.add_event_in_tx(id, EventKind::state, "created", nullptr); !s) return s.error();
-  if (auto s = tx.commit(); !s) return s.error();
+  if (auto s = d.commit(tx, "creating a sweep"); !s) return s.error();
   return id;
 }
 
 Status Store::set_sweep_state(std::int64_t sweep_id, SweepState state, const std::optional<std::string>& error,
                               bool sparse_plan) {
   auto& d = impl();
+  const std::string what = "changing the state of sweep " + std::to_string(sweep_id);
   Transaction tx(d.db, d.tx);
-  if (auto s = tx.begin(); !s) return s;
+  if (auto s = d.begin(tx, what); !s) return s;
+  if (auto s = d.change_state_in_tx(sweep_id, state, error, sparse_plan); !s) return s;
+  return d.commit(tx, what);
+}
 
-  SweepState from{};
-  std::optional<std::string> started_at;
-  std::int64_t total = 0, stored = 0;
+Result<std::vector<LeftRunning>> Store::abort_left_running() {
+  auto& d = impl();
+  const std::string what = "marking sweeps left running";
+  // One write transaction: a `synbench sweep --resume` cannot take a sweep over between the
+  // owner's check and the change.
+  Transaction tx(d.db, d.tx);
+  if (auto s = d.begin(tx, what); !s) return s.error();
+  struct Row {
+    std::int64_t id;
+    std::optional<std::string> host;
+    std::optional<std::int64_t> pid;
+    std::optional<std::string> start;
+  };
+  std::vector<Row> rows;
   {
-    auto& st = d.sweep_for_update;
+    auto& st = d.select_running;
     Statement::Use use(st);
-    st.bind(1, sweep_id);
-    const int rc = st.step();
-    if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
-    if (rc != SQLITE_ROW) return d.fail(rc, "reading the sweep's state");
-    const auto f = parse_sweep_state(st.text(0));
-    if (!f) return make_error(errc::bad_record, "sweep " + std::to_string(sweep_id) + " has an unknown state");
-    from = *f;
-    started_at = st.opt_text(1);
-    total = st.integer(2);
-    stored = st.integer(3);
+    for (;;) {
+      const int rc = st.step();
+      if (rc == SQLITE_DONE) break;
+      if (rc != SQLITE_ROW) return d.fail(rc, what);
+      rows.push_back({st.integer(0), st.opt_text(1),
+                      st.is_null(2) ? std::nullopt : std::optional<std::int64_t>(st.integer(2)), st.opt_text(3)});
+    }
   }
-  const std::string transition = std::string(name(from)) + " -> " + std::string(name(state));
-  if (from == SweepState::completed && state != SweepState::completed)
-    return make_error(errc::invalid_transition, transition + ": a completed sweep is final");
-  if (state == SweepState::created && from != SweepState::created)
-    return make_error(errc::invalid_transition, transition + ": a sweep cannot return to created");
-  if (state == SweepState::completed && stored < total && !sparse_plan)
-    return make_error(errc::invalid_transition, transition + ": only " + std::to_string(stored) + " of " +
-                                                    std::to_string(total) + " points are stored");
-
-  const std::string now = now_utc();
-  if (state == SweepState::running && !started_at) started_at = now;
-  {
-    auto& st = d.update_sweep_state;
-    Statement::Use use(st);
-    st.bind(1, name(state));
-    st.bind(2, started_at);
-    st.bind(3, finished(state) ? std::optional<std::string>(now) : std::nullopt);
-    st.bind(4, error);
-    st.bind(5, sweep_id);
-    const int rc = st.step();
-    if (rc != SQLITE_DONE) return d.fail(rc, "changing the sweep's state");
+  std::vector<LeftRunning> out;
+  for (const auto& r : rows) {
+    const std::string owner = detail::describe_owner(r.host, r.pid);
+    const std::string sweep = "sweep " + std::to_string(r.id);
+    switch (detail::liveness(r.host, r.pid, r.start)) {
+      case detail::Liveness::alive:
+        out.push_back({r.id, false, sweep + " is running in " + owner + ": left alone"});
+        break;
+      case detail::Liveness::unknown:
+        out.push_back({r.id, false,
+                       sweep + " is marked running by " + owner +
+                           ", which this process cannot see (another host or container): left alone"});
+        break;
+      case detail::Liveness::gone: {
+        const std::string why = "marked aborted at start: left running by a previous process (" + owner + ")";
+        if (auto s = d.change_state_in_tx(r.id, SweepState::aborted, why, false); !s) return s.error();
+        out.push_back({r.id, true, sweep + " " + why});
+        break;
+      }
+    }
   }
-  const std::string message = error ? transition + ": " + *error : transition;
-  if (auto s = d.add_event_in_tx(sweep_id, EventKind::state, message, nullptr); !s) return s;
-  return tx.commit();
+  if (auto s = d.commit(tx, what); !s) return s.error();
+  return out;
 }
 
 Result<Sweep> Store::get_sweep(std::int64_t sweep_id) {
   auto& d = impl();
+  if (auto s = d.check_file(); !s) return s.error();
   auto& st = d.select_sweep;
   Statement::Use use(st);
   st.bind(1, sweep_id);
@@ -423,6 +580,8 @@ Result<Sweep> Store::get_sweep(std::int64_t sweep_id) {
 
 Result<std::vector<Sweep>> Store::list_sweeps() {
   auto& d = impl();
+  // A read too: what a lost file answers is no longer what is on disk at the path.
+  if (auto s = d.check_file(); !s) return s.error();
   auto& st = d.select_sweeps;
   Statement::Use use(st);
   std::vector<Sweep> out;
@@ -440,7 +599,7 @@ Status Store::insert_point(std::int64_t sweep_id, std::int64_t point_index, cons
   auto& d = impl();
   const std::string which = "point " + std::to_string(point_index) + " of sweep " + std::to_string(sweep_id);
   Transaction tx(d.db, d.tx);
-  if (auto s = tx.begin(); !s) return s;
+  if (auto s = d.begin(tx, "storing " + which); !s) return s;
   {
     auto& st = d.sweep_total;
     Statement::Use use(st);
@@ -468,12 +627,12 @@ Status Store::insert_point(std::int64_t sweep_id, std::int64_t point_index, cons
       return make_error(errc::duplicate_point, which + " is already stored");
     if (rc != SQLITE_DONE) return d.fail(rc, "storing " + which);
   }
-  if (auto s = tx.commit(); !s) return Error{s.error().code, "storing " + which + ": " + s.error().message};
-  return {};
+  return d.commit(tx, "storing " + which);
 }
 
 Result<std::vector<PointRow>> Store::points(std::int64_t sweep_id) {
   auto& d = impl();
+  if (auto s = d.check_file(); !s) return s.error();
   auto e = d.exists(sweep_id);
   if (!e) return e.error();
   if (!*e) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
@@ -501,6 +660,7 @@ Result<std::vector<PointRow>> Store::points(std::int64_t sweep_id) {
 
 Result<std::vector<std::int64_t>> Store::missing_indices(std::int64_t sweep_id) {
   auto& d = impl();
+  if (auto s = d.check_file(); !s) return s.error();
   std::int64_t total = 0;
   {
     auto& st = d.sweep_total;
@@ -539,15 +699,16 @@ Result<std::optional<std::int64_t>> Store::first_missing_index(std::int64_t swee
 Result<std::int64_t> Store::add_event(std::optional<std::int64_t> sweep_id, EventKind kind, std::string_view message) {
   auto& d = impl();
   Transaction tx(d.db, d.tx);
-  if (auto s = tx.begin(); !s) return s.error();
+  if (auto s = d.begin(tx, "recording an event"); !s) return s.error();
   std::int64_t id = 0;
   if (auto s = d.add_event_in_tx(sweep_id, kind, message, &id); !s) return s.error();
-  if (auto s = tx.commit(); !s) return s.error();
+  if (auto s = d.commit(tx, "recording an event"); !s) return s.error();
   return id;
 }
 
 Result<std::vector<Event>> Store::events(std::optional<std::int64_t> sweep_id) {
   auto& d = impl();
+  if (auto s = d.check_file(); !s) return s.error();
   if (sweep_id) {
     auto e = d.exists(*sweep_id);
     if (!e) return e.error();
@@ -578,7 +739,7 @@ Status Store::integrity_check() {
   std::string findings;
   for (const char* sql : {"PRAGMA integrity_check", "PRAGMA foreign_key_check"}) {
     auto st = Statement::prepare(d.db, sql);
-    if (!st) return st.error();
+    if (!st) return d.report(st.error());
     for (;;) {
       const int rc = st->step();
       if (rc == SQLITE_DONE) break;

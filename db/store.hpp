@@ -10,10 +10,17 @@
 // connections may read the same file concurrently (WAL); writers wait up to busy_timeout.
 //
 // Errors: every call returns Status or Result<T>; nothing throws except on programmer errors
-// (reading the value of a failed Result, or calling anything on a moved-from Store).
+// (reading the value of a failed Result, or calling anything on a moved-from Store). Messages
+// name the file and carry SQLite's own text and extended code.
+//
+// A lost file: before each write transaction, after each commit and before each read, the store
+// checks that the file (and its -wal, -shm) it has open is still the one at its path, and
+// answers errc::file_lost once it was deleted or replaced: SQLite would go on committing into
+// the unlinked file, and its points would vanish unseen.
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,13 +35,25 @@ namespace synbench::db {
 
 struct StoreOptions {
   int busy_timeout_ms = 5000;  // how long a write waits for another connection's lock
+  // At open, PRAGMA quick_check (a file with damaged pages is refused, errc::corrupt) and a
+  // committed write (a file that cannot be written is refused, errc::read_only). Costs a scan of
+  // the file: for a process's start (the daemon, `synbench sweep`), not for every connection.
+  bool verify = false;
+  // SQLite's max_page_count for this connection, if set: a size limit, past which writes fail
+  // with errc::disk_full as on a full disk (the tests' way to fill the disk).
+  std::optional<std::int64_t> max_page_count;
+  // Told of every failure of the storage itself (is_storage_failure: SQLite, the file, the disk),
+  // with the message the caller gets; not of refusals such as an unknown sweep. For the log.
+  std::function<void(const Error&)> on_error;
 };
 
 class Store {
  public:
   // Creates the file if needed, sets WAL, synchronous=FULL, foreign_keys and busy_timeout, and
-  // applies pending migrations. Refuses a database newer than this code (errc::schema_too_new)
-  // or another application's database (errc::not_synbench).
+  // applies pending migrations. Refuses a database newer than this code (errc::schema_too_new),
+  // another application's database (errc::not_synbench), a file SQLite could open only for
+  // reading (errc::read_only), and with options.verify a damaged (errc::corrupt) or unwritable
+  // one.
   static Result<Store> open(const std::filesystem::path& path, const StoreOptions& options = {});
 
   Store(Store&&) noexcept;
@@ -60,6 +79,12 @@ class Store {
                          bool sparse_plan = false);
   Result<Sweep> get_sweep(std::int64_t sweep_id);
   Result<std::vector<Sweep>> list_sweeps();  // by id
+  // Sweeps in state `running` whose process is gone (it crashed, the machine restarted, or it
+  // ran before owners were recorded) become `aborted`, each with the state event "running ->
+  // aborted: marked aborted at start: left running by a previous process (pid 12 on host)", in
+  // one transaction. A sweep whose process still runs (`synbench sweep` on the same file), or
+  // runs where this process cannot see (another container), is left alone and reported.
+  Result<std::vector<LeftRunning>> abort_left_running();
 
   // --- points ---
   // Stores one point in its own transaction, committed (fsynced) before returning.

@@ -50,6 +50,14 @@ struct PointRow {
   bench::PointRecord record;
 };
 
+// A sweep found `running` when a daemon starts (Store::abort_left_running): its process is gone
+// (the sweep is marked aborted), or it may still run (left alone).
+struct LeftRunning {
+  std::int64_t sweep_id = 0;
+  bool marked_aborted = false;
+  std::string message;  // what was found and done, for the log
+};
+
 enum class EventKind { fault, state, log };
 
 std::string_view name(EventKind k) noexcept;

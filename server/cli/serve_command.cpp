@@ -19,6 +19,7 @@
 #include "server/cli/args.hpp"
 #include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
+#include "server/cli/db_log.hpp"
 #include "server/cli/serve_options.hpp"
 #include "server/http/api_routes.hpp"
 #include "app/bench_backend.hpp"
@@ -128,10 +129,23 @@ int serve_command(const std::vector<std::string>& argv) {
               << ", mode 0600; more with `synbench token create`)\n";
   }
 
-  auto store = db::Store::open(data_dir / "synbench.db");
+  // Checked at start: damaged pages (quick_check) and a file that cannot be written are refused
+  // here, not found in the middle of a sweep. Every later storage failure is logged.
+  db::StoreOptions store_options;
+  store_options.verify = true;
+  store_options.on_error = db_error_logger("synbench serve: ");
+  auto store = db::Store::open(data_dir / "synbench.db", store_options);
   if (!store) {
-    std::cerr << "synbench serve: cannot open " << (data_dir / "synbench.db").string() << ": " << store.error().message << "\n";
+    std::cerr << "synbench serve: cannot use the database: " << store.error().message << "\n";
     return 1;
+  }
+  // Sweeps a crashed process left `running` are not running: marked aborted (resumable), each
+  // with its event; one that `synbench sweep` runs on this file right now is left alone.
+  if (auto left = store->abort_left_running(); !left) {
+    std::cerr << "synbench serve: cannot use the database: " << left.error().message << "\n";
+    return 1;
+  } else {
+    for (const auto& l : *left) std::cerr << "synbench serve: " << l.message << "\n";
   }
 
   const std::string bench_what = real_bench ? "the bench of " + options.bench->string() : "the in-process twin";

@@ -23,6 +23,7 @@
 #include "server/cli/args.hpp"
 #include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
+#include "server/cli/db_log.hpp"
 
 namespace synbench::cli {
 
@@ -188,9 +189,13 @@ int sweep_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
-  auto opened = db::Store::open(db_path);
+  // Checked before the bench moves: damaged pages and a file that cannot be written are refused.
+  db::StoreOptions store_options;
+  store_options.verify = true;
+  store_options.on_error = db_error_logger("synbench sweep: ");
+  auto opened = db::Store::open(db_path, store_options);
   if (!opened) {
-    std::cerr << "synbench sweep: --db " << db_path << ": " << opened.error().message << "\n";
+    std::cerr << "synbench sweep: --db: " << opened.error().message << "\n";
     return 1;
   }
   db::Store store = std::move(*opened);

@@ -142,7 +142,7 @@ TEST(Migrations, ReportAnUnopenableFile) {
 }
 
 TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
-  // A file as version 1 left it (the columns of steps 2 and 3 dropped again, user_version 1):
+  // A file as version 1 left it (the columns of steps 2 to 4 dropped again, user_version 1):
   // opening it applies the later steps, and its points read back with the new fields at their
   // defaults.
   TempDir dir;
@@ -163,6 +163,9 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
     raw.exec("ALTER TABLE points DROP COLUMN lock_lost");
     raw.exec("ALTER TABLE points DROP COLUMN fallback_fraction");
     raw.exec("ALTER TABLE points DROP COLUMN below_min_speed");
@@ -177,6 +180,38 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   EXPECT_EQ(rows[0].record.fallback_fraction, 0.0);
   EXPECT_FALSE(rows[0].record.lock_lost);
   EXPECT_EQ(rows[0].record.im_A, testing::sample_record(3).im_A);
+}
+
+TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
+  // Step 4: a sweep a version-3 synbench left running has no owner; opening the file adds the
+  // columns (NULL), and the sweep counts as left by a previous process.
+  TempDir dir;
+  const auto path = dir / "v3.db";
+  std::int64_t id = 0;
+  {
+    auto store = Store::open(path);
+    ASSERT_TRUE(store) << store.error().message;
+    SweepMeta meta;
+    meta.name = "v3";
+    meta.total_points = 1;
+    id = store->create_sweep(meta).value();
+    ASSERT_TRUE(store->set_sweep_state(id, SweepState::running));
+  }
+  {
+    Raw raw(path);
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
+    raw.exec("PRAGMA user_version = 3");
+  }
+  auto store = Store::open(path);
+  ASSERT_TRUE(store) << store.error().message;
+  EXPECT_EQ(store->pragma("user_version").value(), "4");
+  EXPECT_EQ(Raw(path).column("SELECT coalesce(owner_pid, 'NULL') FROM sweeps"), std::vector<std::string>{"NULL"});
+  const auto left = store->abort_left_running().value();
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_TRUE(left[0].marked_aborted);
+  EXPECT_EQ(store->get_sweep(id).value().state, SweepState::aborted);
 }
 
 TEST(Migrations, EachStepIsOneTransaction) {
