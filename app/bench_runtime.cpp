@@ -97,6 +97,10 @@ void BenchRuntime::run() {
     const auto snap = snapshot();
     for (auto& [done, refusal] : answers)
       if (done) done({std::move(refusal), snap});
+    if (sweep_ && sweep_->finished()) {
+      finish_sweep(now_s);
+      publish();
+    }
     if (due) {
       next += kTick;
       const auto now = clock::now();
@@ -159,9 +163,10 @@ void BenchRuntime::tick(double now_s) {
   // An E-stop that arrived during the reads goes first: nothing else commands the drives.
   if (estop_pending()) return;
   if (sweep_) {
-    // The engine reads the supervisor's verdict itself: a trip faults the sweep.
+    // The engine reads the supervisor's verdict itself: a trip faults the sweep. Its end is
+    // recorded after this tick's commands are answered (run()): an E-stop's answer never waits
+    // for the store's commit.
     sweep_->tick(now_s);
-    if (sweep_->finished()) finish_sweep(now_s);
     return;
   }
   if (supervisor_->tripped()) {
@@ -329,8 +334,8 @@ void BenchRuntime::reset(Done done) {
             supervisor_->phase() == bench::SafetyPhase::stopping_speed)
           return Refusal{Refused::stop_in_progress, "reset refused: the ordered stop is still under way"};
         if (ec == errc::busy)
-          return Refusal{Refused::drive_running, "reset refused: a drive has not read back stopped" +
-                                                      (supervisor_->alarm() ? " (" + supervisor_->alarm()->detail + ")" : std::string())};
+          return Refusal{Refused::drive_running, "reset refused: " + supervisor_->unconfirmed() +
+                                                      (supervisor_->alarm() ? " (alarm: " + supervisor_->alarm()->detail + ")" : std::string())};
         return device_error("reset refused: clearing the drives' faults failed", ec);
       },
       std::move(done));

@@ -71,7 +71,7 @@ void SafetySupervisor::expect_stopped(double now_s) {
   if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
 }
 
-std::string SafetySupervisor::still_running() const {
+std::string SafetySupervisor::unconfirmed() const {
   std::string s;
   const auto add = [&s](const char* what) { s += (s.empty() ? "" : " and ") + std::string(what); };
   if (!synrm_) add("the SynRM drive cannot be read");
@@ -83,7 +83,7 @@ std::string SafetySupervisor::still_running() const {
 
 void SafetySupervisor::confirm_stop(double now_s) {
   if (!confirm_deadline_s_) return;
-  const std::string running = still_running();
+  const std::string running = unconfirmed();
   if (running.empty()) {
     confirm_deadline_s_.reset();
     return;
@@ -103,7 +103,7 @@ std::error_code SafetySupervisor::reset() {
   if (stop_.active()) return make_error_code(errc::busy);
   if (alarm_ || confirm_deadline_s_) {
     // A reset must never hide a drive that did not stop.
-    if (!still_running().empty()) return make_error_code(errc::busy);
+    if (!unconfirmed().empty()) return make_error_code(errc::busy);
   }
   if (auto ec = dev_.synrm->reset_fault()) return ec;
   if (auto ec = dev_.load->reset_fault()) return ec;

@@ -83,6 +83,9 @@ class SafetySupervisor {
   const std::optional<SafetyAlarm>& alarm() const { return alarm_; }
   // Set while a stop's disable is being confirmed by reading the drives back.
   bool confirming_stop() const { return confirm_deadline_s_.has_value(); }
+  // Which drives the last read found running or could not read, in words ("the SynRM drive
+  // still reports running"); empty when both read back off.
+  std::string unconfirmed() const;
   // Time from detection to both drives disabled, once the stop has completed.
   std::optional<double> stop_duration_s() const { return stop_duration_s_; }
 
@@ -91,8 +94,6 @@ class SafetySupervisor {
   void advance_stop(double now_s);
   void disable_all();
   void confirm_stop(double now_s);
-  // Which drives read back as running (or unreadable), in words; empty when both are off.
-  std::string still_running() const;
 
   drivers::BenchDevices dev_;
   SafetyLimits lim_;

@@ -107,7 +107,13 @@ class Bench:
     def trial(self, condition):
         """One E-stop: (latency s, reply s)."""
         if self.latched:
-            status, body = self.serve.request("POST", "/api/bench/reset")
+            # Refused while the daemon has not yet read both drives back stopped (a slow line):
+            # an operator tries again a moment later.
+            for _ in range(20):
+                status, body = self.serve.request("POST", "/api/bench/reset")
+                if status == 200 or not (isinstance(body, dict) and body.get("error", {}).get("code") == "drive_running"):
+                    break
+                time.sleep(0.1)
             if status != 200:
                 raise TrialError("reset -> %s %s" % (status, str(body)[:160]))
             self.latched = False

@@ -252,7 +252,9 @@ def tcp_link(port):
 
 
 def rtu_link(device):
-    return {"transport": "rtu", "device": device, "baud": 115200, "response_timeout_ms": 200}
+    # A timeout is followed by a drain until the line is quiet: tens of ms, not the default 200
+    # (docs/modbus.md), or two lost replies in a tick cost the 0.5 s telemetry deadline.
+    return {"transport": "rtu", "device": device, "baud": 115200, "response_timeout_ms": 200, "quiet_ms": 20}
 
 
 class Serve:
