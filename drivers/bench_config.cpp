@@ -4,11 +4,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <fstream>
 #include <initializer_list>
 #include <set>
 #include <utility>
 
+#include "drivers/json_file.hpp"
 #include "drivers/profile/number_format.hpp"
 
 namespace synbench::drivers {
@@ -236,15 +236,9 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
 }
 
 BenchConfigResult load_bench_config(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) return {std::nullopt, {{"", "cannot read '" + file.string() + "'"}}};
-  json doc;
-  try {
-    doc = json::parse(in, nullptr, true, /*ignore_comments=*/false);
-  } catch (const json::parse_error& e) {
-    return {std::nullopt, {{"", "'" + file.string() + "' is not valid JSON: " + e.what()}}};
-  }
-  return parse_bench_config(doc, file.parent_path());
+  JsonParsed read = read_json_file(file);
+  if (!read.ok()) return {std::nullopt, {{"", read.error}}};
+  return parse_bench_config(read.doc, file.parent_path());
 }
 
 void override_unit_id(DeviceProfile& profile, std::uint8_t unit_id) {
@@ -259,7 +253,14 @@ std::optional<BenchProfiles> load_bench_profiles(const BenchConfig& config, std:
   for (const DeviceKind kind : kDeviceKinds) {
     const DeviceConfig& d = config.device(kind);
     const std::string path = "/devices/" + std::string(name(kind)) + "/profile";
-    ProfileParseResult r = load_device_profile(d.profile);
+    // Read here rather than through load_device_profile: a read error already names the file.
+    const JsonParsed read = read_json_file(d.profile);
+    if (!read.ok()) {
+      errors.push_back({path, read.error});
+      ok = false;
+      continue;
+    }
+    ProfileParseResult r = parse_device_profile(read.doc);
     if (!r.profile) {
       for (const ProfileError& e : r.errors)
         errors.push_back({path, d.profile.string() + (e.path.empty() ? "" : " " + e.path) + ": " + e.reason});

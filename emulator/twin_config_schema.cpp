@@ -4,10 +4,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
+
+#include "drivers/json_file.hpp"
 
 namespace synbench::emulator {
 namespace {
@@ -294,16 +295,10 @@ void apply_json(TwinConfig& config, const nlohmann::json& doc) {
 }
 
 TwinConfig load_twin_config_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError("(file)", "cannot open '" + path + "'");
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw ConfigError("(file)", "'" + path + "' is not valid JSON: " + e.what());
-  }
+  const drivers::JsonParsed read = drivers::read_json_file(path);
+  if (!read.ok()) throw ConfigError("(file)", read.error);
   TwinConfig config;
-  apply_json(config, doc);
+  apply_json(config, read.doc);
   return config;
 }
 

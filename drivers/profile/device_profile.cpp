@@ -8,10 +8,10 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <tuple>
 
+#include "drivers/json_file.hpp"
 #include "drivers/profile/number_format.hpp"
 
 #ifndef SYNBENCH_PROFILE_DIR
@@ -445,15 +445,9 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
 }
 
 ProfileParseResult load_device_profile(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) return {std::nullopt, {{"", "cannot open " + file.string()}}};
-  json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::parse_error& e) {
-    return {std::nullopt, {{"", file.string() + " is not valid JSON: " + e.what()}}};
-  }
-  return parse_device_profile(doc);
+  JsonParsed read = read_json_file(file);
+  if (!read.ok()) return {std::nullopt, {{"", read.error}}};
+  return parse_device_profile(read.doc);
 }
 
 std::filesystem::path default_profile_dir() {

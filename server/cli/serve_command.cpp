@@ -15,6 +15,7 @@
 #include <iostream>
 
 #include "db/store.hpp"
+#include "drivers/utf8.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
 #include "server/cli/bench_setup.hpp"
@@ -155,7 +156,7 @@ int serve_command(const std::vector<std::string>& argv) {
       std::cerr << "synbench serve: bench " << e.kind << ": " << e.message << "\n";
   };
   app::BenchRuntime bench(make_backend(std::move(real_bench), config),
-                          [](const app::BenchStatus& s) { return http::status_json(s).dump(); }, log);
+                          [](const app::BenchStatus& s) { return http::dump_json(http::status_json(s)); }, log);
   http::HttpMetrics metrics;
   http::Router router([&tokens](std::string_view t) { return tokens.authenticate(t); });
   http::ControlLock control;
@@ -223,7 +224,18 @@ int serve_command(const std::vector<std::string>& argv) {
   const bool v6 = host.find(':') != std::string::npos;
   std::cout << "listening on http://" << (v6 ? "[" + host + "]" : host) << ":" << server.port() << std::endl;
   std::cerr << "synbench serve: bench: " << bench_what << "\n";
-  io.run();
+  // The io loop outlives anything thrown inside it: every handler and session guards its own
+  // work, and this is the last line, so one request can never end the daemon.
+  for (;;) {
+    try {
+      io.run();
+      break;
+    } catch (const std::exception& e) {
+      std::cerr << "synbench serve: the io loop caught: " << drivers::escape_invalid_utf8(e.what()) << "\n";
+    } catch (...) {
+      std::cerr << "synbench serve: the io loop caught an exception that is not a std::exception\n";
+    }
+  }
   worker.stop();  // its answers go to the io_context, which must outlive them
   if (stopper.joinable()) stopper.join();
   bench.shutdown();

@@ -2,11 +2,11 @@
 #include "server/cli/serve_options.hpp"
 
 #include <cstdlib>
-#include <fstream>
 #include <set>
 
 #include <nlohmann/json.hpp>
 
+#include "drivers/json_file.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
 
@@ -43,16 +43,10 @@ struct FileSettings {
 };
 
 FileSettings read_config_file(const std::filesystem::path& file, const std::string& flag) {
-  std::ifstream in(file);
-  if (!in) throw UsageError(flag, "cannot read '" + file.string() + "'");
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    std::string what = e.what();
-    if (auto b = what.find("] "); b != std::string::npos) what = what.substr(b + 2);
-    throw UsageError(flag, file.string() + " is not JSON: " + what);
-  }
+  // "cannot read PATH: cannot open: No such file or directory", "cannot read PATH: not valid JSON: ..."
+  drivers::JsonParsed read = drivers::read_json_file(file);
+  if (!read.ok()) throw UsageError(flag, "cannot read " + read.error);
+  const nlohmann::json& doc = read.doc;
   if (!doc.is_object()) throw UsageError(flag, file.string() + ": the top level must be an object");
   const auto base = file.parent_path();
   const auto at = [&](const std::string& key, const std::string& reason) {

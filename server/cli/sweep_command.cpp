@@ -16,6 +16,7 @@
 #include "bench/sweep_plan.hpp"
 #include "db/export.hpp"
 #include "db/store.hpp"
+#include "drivers/json_file.hpp"
 #include "app/bench_backend.hpp"
 #include "app/supervised_point.hpp"
 #include "app/sweep_run.hpp"
@@ -166,15 +167,9 @@ int sweep_command(const std::vector<std::string>& argv) {
     } else {
       if (a.positional().size() != 1) throw UsageError("PLAN.json", "exactly one plan file is required");
       const std::string& file = a.positional().front();
-      std::ifstream in(file);
-      if (!in) throw UsageError("PLAN.json", "cannot open '" + file + "'");
-      nlohmann::json doc;
-      try {
-        doc = nlohmann::json::parse(in);
-      } catch (const nlohmann::json::parse_error& e) {
-        throw UsageError("PLAN.json", "'" + file + "' is not valid JSON: " + e.what());
-      }
-      auto parsed = bench::parse_sweep_plan(doc);
+      const drivers::JsonParsed read = drivers::read_json_file(file);
+      if (!read.ok()) throw UsageError("PLAN.json", read.error);
+      auto parsed = bench::parse_sweep_plan(read.doc);
       if (!parsed.errors.empty()) {
         for (const auto& e : parsed.errors) std::cerr << "synbench sweep: " << file << ": " << bench::to_string(e) << "\n";
         return 2;

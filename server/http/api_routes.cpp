@@ -3,6 +3,8 @@
 
 #include "server/http/info_routes.hpp"
 
+#include "drivers/json_file.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -23,18 +25,13 @@ std::map<int, std::uint64_t> HttpMetrics::by_status() const {
 
 std::variant<nlohmann::json, Response> parse_json_object(const std::string& body) {
   if (body.empty()) return error_response(400, "bad_json", "the request needs a JSON object body");
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(body);
-  } catch (const nlohmann::json::exception& e) {
-    // Syntax errors and numbers out of double's range (1e999); e.what() names the position: "parse error at line 1, column 9: syntax error ..."
-    std::string what = e.what();
-    const auto bracket = what.find("] ");
-    if (bracket != std::string::npos) what = what.substr(bracket + 2);
-    return error_response(400, "bad_json", "the body is not JSON: " + what);
-  }
-  if (!doc.is_object()) return error_response(400, "bad_json", "the body must be a JSON object");
-  return doc;
+  // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
+  // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
+  // ...", a number out of double's range (1e999) included.
+  drivers::JsonParsed parsed = drivers::parse_json_text(body);
+  if (!parsed.ok()) return error_response(400, "bad_json", "the body is " + parsed.error);
+  if (!parsed.doc.is_object()) return error_response(400, "bad_json", "the body must be a JSON object");
+  return std::move(parsed.doc);
 }
 
 namespace {
@@ -58,10 +55,16 @@ std::string fmt(double v) {
   return s.str();
 }
 
-// Hands the bench's answer to the HTTP reply.
-BenchRuntime::Done answer(Reply reply, int ok_status = 200) {
-  return [reply = std::move(reply), ok_status](app::Outcome o) { reply(outcome_response(o, ok_status)); };
+}  // namespace
+
+BenchRuntime::Done answer(Reply reply, int ok_status) {
+  // Runs on the bench thread, which has no handler for an exception: guarded makes it a 500.
+  return [reply = std::move(reply), ok_status](app::Outcome o) {
+    reply(guarded("a bench command's answer", [&] { return outcome_response(o, ok_status); }));
+  };
 }
+
+namespace {
 
 // Rejects fields other than `known`, so a typo ("speed") is an error instead of a no-op.
 std::optional<Response> unknown_fields(const nlohmann::json& doc, const std::set<std::string>& known) {

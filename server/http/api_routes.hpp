@@ -131,6 +131,9 @@ nlohmann::json status_json(const BenchStatus& s);
 int http_status(app::Refused r);
 // A command's outcome: its refusal as an error, else `ok_status` with the status after it.
 Response outcome_response(const app::Outcome& o, int ok_status = 200);
+// The bench thread's callback for a command: hands outcome_response to `reply`, an exception
+// on the way being a 500 rather than the end of the bench thread.
+BenchRuntime::Done answer(Reply reply, int ok_status = 200);
 // The snapshot's status text as a 200.
 Response status_response(const app::StatusSnapshot& s);
 // The supervisor's phase as the API names it: "normal", "stopping_load", ... "estopped".

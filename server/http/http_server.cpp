@@ -10,6 +10,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket/rfc6455.hpp>
 
+#include "drivers/utf8.hpp"
 #include "server/http/connection_registry.hpp"
 #include "server/http/sign_in_log.hpp"
 #include "server/http/static_files.hpp"
@@ -145,7 +146,14 @@ class Session : public std::enable_shared_from_this<Session> {
         return send_error(400, "bad_request", "malformed HTTP request: " + ec.message(), false);
       return fail(ec, "read");
     }
-    handle(parser_->release());
+    // Nothing thrown while answering may reach io.run(): it would end the daemon for every
+    // client. The request is answered 500 and the line on stderr says what was caught.
+    try {
+      handle(parser_->release());
+    } catch (const std::exception& e) {
+      std::cerr << "synbench serve: internal error answering a request: " << drivers::escape_invalid_utf8(e.what()) << "\n";
+      send_error(500, "internal", "the request failed inside the daemon", false);
+    }
   }
 
   void handle(bhttp::request<bhttp::string_body> req) {
@@ -165,7 +173,10 @@ class Session : public std::enable_shared_from_this<Session> {
     const std::string target(req.target());
     const std::string path = target.substr(0, target.find('?'));
     Response r;
-    if (!shared_->hosts.count(lower(host))) {
+    if (req.count(bhttp::field::host) > 1) {
+      // Two Host headers name two targets; RFC 9112 Sec. 3.2 asks for a 400.
+      r = error_response(400, "bad_request", "more than one Host header");
+    } else if (!shared_->hosts.count(lower(host))) {
       r = error_response(403, "host_not_allowed", "the Host header must name the listen address");
     } else if (path == "/ws" && shared_->hub) {
       const std::string origin(req[bhttp::field::origin]);

@@ -2,12 +2,14 @@
 #include "server/http/router.hpp"
 
 #include <atomic>
+#include <exception>
 #include <future>
+#include <iostream>
 #include <memory>
+#include <set>
 #include <utility>
 
-#include <exception>
-#include <set>
+#include "drivers/utf8.hpp"
 
 namespace synbench::http {
 
@@ -26,11 +28,29 @@ std::optional<Role> parse_role(std::string_view name) {
   return std::nullopt;
 }
 
+std::string dump_json(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+std::string dump_json(const nlohmann::ordered_json& j) {
+  return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+}
+
 Response json_response(int status, const nlohmann::json& body) {
   Response r;
   r.status = status;
-  r.body = body.dump();
+  r.body = dump_json(body);
   return r;
+}
+
+Response guarded(const char* what, const std::function<Response()>& make) {
+  std::string why;
+  try {
+    return make();
+  } catch (const std::exception& e) {
+    why = drivers::escape_invalid_utf8(e.what());
+  } catch (...) {
+    why = "an exception that is not a std::exception";
+  }
+  std::cerr << "synbench serve: internal error in " << drivers::escape_invalid_utf8(what) << ": " << why << "\n";
+  return error_response(500, "internal", "the request failed inside the daemon: " + why);
 }
 
 Response error_response(int status, const std::string& code, const std::string& message) {
@@ -127,14 +147,62 @@ Response Router::dispatch(const std::string& method, const std::string& target, 
   return future.get();
 }
 
+namespace {
+
+// The first path or query parameter that is not UTF-8 once percent-decoded, as a 400 naming it:
+// handlers and their messages may then treat every parameter as text.
+std::optional<Response> non_utf8_parameter(const Request& req) {
+  for (const auto& [name, value] : req.params)
+    if (!drivers::is_valid_utf8(value)) return error_response(400, "bad_field", name + ": not valid UTF-8");
+  for (const auto& [name, value] : req.query) {
+    if (!drivers::is_valid_utf8(name))
+      return error_response(400, "bad_field", "query: the parameter name '" + drivers::escape_invalid_utf8(name) + "' is not valid UTF-8");
+    if (!drivers::is_valid_utf8(value)) return error_response(400, "bad_field", name + ": not valid UTF-8");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 void Router::dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
                             std::string body, Reply reply) const {
+  // Shared with the handler, which may answer from the bench thread: whichever side answers
+  // first (the handler, or the exception it threw here) is the one answer.
+  struct Once {
+    std::atomic<bool> used{false};
+    Reply reply;
+    void operator()(Response r) {
+      if (!used.exchange(true)) reply(std::move(r));
+    }
+  };
+  auto once = std::make_shared<Once>();
+  once->reply = std::move(reply);
+  // Nothing thrown here may reach the io loop: routing, the token check and the handler are all
+  // inside, and an exception becomes the one 500 answer.
+  const auto failed = [&](const std::string& why) {
+    std::cerr << "synbench serve: internal error in " << drivers::escape_invalid_utf8(method + " " + target.substr(0, target.find('?')))
+              << ": " << why << "\n";
+    (*once)(error_response(500, "internal", "the request failed inside the daemon: " + why));
+  };
+  try {
+    route_and_call(method, target, authorization, std::move(body), [once](Response r) { (*once)(std::move(r)); });
+  } catch (const std::exception& e) {
+    failed(drivers::escape_invalid_utf8(e.what()));
+  } catch (...) {
+    failed("an exception that is not a std::exception");
+  }
+}
+
+void Router::route_and_call(const std::string& method, const std::string& target, std::string_view authorization,
+                            std::string body, const Reply& reply) const {
   Request req;
   req.method = method;
   const std::size_t q = target.find('?');
   req.path = target.substr(0, q);
   if (q != std::string::npos) req.query = parse_query(std::string_view(target).substr(q + 1));
   req.body = std::move(body);
+  // The path is echoed in messages; a byte that is not UTF-8 is shown as \xNN.
+  const std::string shown_path = drivers::escape_invalid_utf8(req.path);
 
   const Route* route = nullptr;
   std::set<std::string> allowed;
@@ -150,10 +218,11 @@ void Router::dispatch_async(const std::string& method, const std::string& target
     }
   }
   if (!route) {
-    if (allowed.empty()) return reply(error_response(404, "not_found", "no route for " + req.path));
+    if (allowed.empty()) return reply(error_response(404, "not_found", "no route for " + shown_path));
     std::string allow;
     for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
-    Response r = error_response(405, "method_not_allowed", method + " is not allowed on " + req.path + " (allowed: " + allow + ")");
+    Response r = error_response(405, "method_not_allowed",
+                                drivers::escape_invalid_utf8(method) + " is not allowed on " + shown_path + " (allowed: " + allow + ")");
     r.headers.emplace_back("Allow", allow);
     return reply(std::move(r));
   }
@@ -177,26 +246,9 @@ void Router::dispatch_async(const std::string& method, const std::string& target
     req.caller = caller->role;
     req.caller_id = caller->id;
   }
-  // Shared with the handler, which may answer from the bench thread: whichever side answers
-  // first (the handler, or the exception it threw here) is the one answer.
-  struct Once {
-    std::atomic<bool> used{false};
-    Reply reply;
-    void operator()(Response r) {
-      if (!used.exchange(true)) reply(std::move(r));
-    }
-  };
-  auto once = std::make_shared<Once>();
-  once->reply = std::move(reply);
-  try {
-    if (route->async_handler) {
-      route->async_handler(req, [once](Response r) { (*once)(std::move(r)); });
-      return;
-    }
-    (*once)(route->handler(req));
-  } catch (const std::exception& e) {
-    (*once)(error_response(500, "internal", e.what()));
-  }
+  if (auto bad = non_utf8_parameter(req)) return reply(std::move(*bad));
+  if (route->async_handler) return route->async_handler(req, reply);
+  reply(route->handler(req));
 }
 
 nlohmann::json Router::openapi(const std::string& title, const std::string& version) const {

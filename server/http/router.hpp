@@ -39,9 +39,17 @@ struct Response {
   std::vector<std::pair<std::string, std::string>> headers;  // extra headers (Allow, ...)
 };
 
+// Serialises `j`, writing any string that is not UTF-8 with U+FFFD instead of throwing: every
+// JSON the daemon sends goes through here, as request-derived text can hold any byte.
+std::string dump_json(const nlohmann::json& j);
+std::string dump_json(const nlohmann::ordered_json& j);
 Response json_response(int status, const nlohmann::json& body);
 // {"error": {"code": code, "message": message}}
 Response error_response(int status, const std::string& code, const std::string& message);
+// Runs `make`; an exception it throws becomes a 500 `internal` answer and a line on stderr
+// naming `what`. For handlers and the bench thread's answers: nothing may escape into the io
+// loop or the bench thread.
+Response guarded(const char* what, const std::function<Response()>& make);
 
 using Handler = std::function<Response(const Request&)>;
 // Called exactly once, on any thread.
@@ -81,8 +89,9 @@ class Router {
 
   // `target` is the request-target ("/api/x?y=z"); `authorization` the Authorization header
   // (empty when absent). 404 unknown path, 405 wrong method, 401 no or unknown token, 403 role
-  // too low; otherwise the handler's response, given to `reply` (at once, or from the bench
-  // thread). Never throws: a handler's exception is a 500.
+  // too low; 400 `bad_field` for a path parameter or query parameter that is not UTF-8 after
+  // percent-decoding; otherwise the handler's response, given to `reply` (at once, or from the
+  // bench thread). Never throws: a handler's exception is a 500, logged on stderr.
   void dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
                       std::string body, Reply reply) const;
   // The same, waiting for the answer: for tests and tools, never on the io thread.
@@ -96,6 +105,9 @@ class Router {
   nlohmann::json openapi(const std::string& title, const std::string& version) const;
 
  private:
+  // dispatch_async's body; may throw, which dispatch_async turns into a 500.
+  void route_and_call(const std::string& method, const std::string& target, std::string_view authorization,
+                      std::string body, const Reply& reply) const;
   Authenticator auth_;
   std::vector<Route> routes_;
 };

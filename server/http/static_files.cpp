@@ -7,6 +7,8 @@
 #include <variant>
 #include <vector>
 
+#include "drivers/utf8.hpp"
+
 namespace synbench::http {
 
 namespace fs = std::filesystem;
@@ -167,19 +169,19 @@ Response StaticFiles::serve(std::string_view method, std::string_view target, st
     const fs::path resolved = fs::canonical(root / rel, ec);
     if (!ec) {
       // A symlink may point anywhere: only what resolves inside the directory is served.
-      if (!inside(root, resolved)) return plain_error(404, "not_found", "no file " + std::string(path));
+      if (!inside(root, resolved)) return plain_error(404, "not_found", "no file " + drivers::escape_invalid_utf8(path));
       file = fs::is_directory(resolved, ec) ? resolved / "index.html" : resolved;
     }
   }
   if (file.empty() || !fs::is_regular_file(file, ec)) {
-    if (!route_like) return plain_error(404, "not_found", "no file " + std::string(path));
+    if (!route_like) return plain_error(404, "not_found", "no file " + drivers::escape_invalid_utf8(path));
     if (!has_index) return not_built();
     file = root / "index.html";
   }
 
   const auto size = fs::file_size(file, ec);
-  if (ec) return plain_error(404, "not_found", "no file " + std::string(path));
-  if (size > kMaxFileBytes) return plain_error(500, "file_too_large", std::string(path) + " is larger than the daemon serves");
+  if (ec) return plain_error(404, "not_found", "no file " + drivers::escape_invalid_utf8(path));
+  if (size > kMaxFileBytes) return plain_error(500, "file_too_large", drivers::escape_invalid_utf8(path) + " is larger than the daemon serves");
 
   Response r;
   r.content_type = content_type_for(file);
@@ -198,7 +200,7 @@ Response StaticFiles::serve(std::string_view method, std::string_view target, st
   }
   std::ifstream in(file, std::ios::binary);
   std::string body(static_cast<std::size_t>(size), '\0');
-  if (!in.read(body.data(), static_cast<std::streamsize>(size))) return plain_error(500, "read_failed", "cannot read " + std::string(path));
+  if (!in.read(body.data(), static_cast<std::streamsize>(size))) return plain_error(500, "read_failed", "cannot read " + drivers::escape_invalid_utf8(path));
   r.body = std::move(body);
   return r;
 }

@@ -2,8 +2,11 @@
 #include "server/http/sweep_routes.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
+#include <limits>
 #include <map>
+#include <span>
 #include <string>
 
 #include "bench/analysis.hpp"
@@ -31,7 +34,7 @@ nlohmann::json sweep_json(const db::Sweep& s, bool with_plan) {
                       {"finished_at", optional_json(s.finished_at)},
                       {"last_error", optional_json(s.last_error)},
                       {"software_version", s.meta.software_version}};
-  if (with_plan) j["plan"] = nlohmann::json::parse(s.meta.plan.dump());
+  if (with_plan) j["plan"] = nlohmann::json::parse(dump_json(s.meta.plan));
   return j;
 }
 
@@ -72,6 +75,34 @@ std::optional<std::string> format_of(const Request& req, Response& error) {
     return std::nullopt;
   }
   return format;
+}
+
+// ?offset=&limit= of the points route: a page of at most kMaxPointsPage points, the first page
+// of that size when neither is given (so a sweep of up to that many points comes whole, as
+// before paging existed).
+constexpr std::size_t kMaxPointsPage = 10000;
+struct Page {
+  std::size_t offset = 0, limit = kMaxPointsPage;
+};
+std::optional<Page> page_of(const Request& req, Response& error) {
+  Page page;
+  const auto whole = [&](const char* name, std::size_t lo, std::size_t hi, std::size_t& out) {
+    if (!req.query.count(name)) return true;
+    const std::string& text = req.query.at(name);
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+    if (text.empty() || text.front() == '-' || end != text.c_str() + text.size() || errno == ERANGE || v < lo || v > hi) {
+      error = error_response(400, "bad_field", std::string(name) + ": '" + text + "' is not a whole number in [" +
+                                                   std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      return false;
+    }
+    out = static_cast<std::size_t>(v);
+    return true;
+  };
+  if (!whole("offset", 0, std::numeric_limits<std::int64_t>::max(), page.offset)) return std::nullopt;
+  if (!whole("limit", 1, kMaxPointsPage, page.limit)) return std::nullopt;
+  return page;
 }
 
 Response db_error(const db::Error& e) {
@@ -120,14 +151,13 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 if (!s) return reply(db_error(s.error()));
                 if (s->state == db::SweepState::completed)
                   return reply(error_response(409, "invalid_state", "sweep " + std::to_string(*id) + " is already completed"));
-                auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(s->meta.plan.dump()));
+                auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(dump_json(s->meta.plan)));
                 if (!parsed.plan) return reply(error_response(500, "bad_plan", "the stored plan no longer parses"));
                 auto rows = db->points(*id);
                 if (!rows) return reply(db_error(rows.error()));
                 std::map<std::size_t, bench::PointRecord> stored;
                 for (const auto& row : *rows) stored[static_cast<std::size_t>(row.index)] = row.record;
-                runtime->start_sweep(*id, std::move(*parsed.plan), std::move(stored), db_path,
-                                     [reply = std::move(reply)](app::Outcome o) { reply(outcome_response(o, 202)); });
+                runtime->start_sweep(*id, std::move(*parsed.plan), std::move(stored), db_path, answer(std::move(reply), 202));
               })});
   for (const char* action : {"pause", "resume", "abort"}) {
     const std::string a = action;
@@ -140,7 +170,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   Response err;
                   const auto id = sweep_id(req, err);
                   if (!id) return reply(err);
-                  runtime->sweep_action(*id, a, [reply = std::move(reply)](app::Outcome o) { reply(outcome_response(o)); });
+                  runtime->sweep_action(*id, a, answer(std::move(reply)));
                 })});
   }
   router.add({"POST", "/api/sweeps", Role::operator_,
@@ -180,25 +210,32 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 return json_response(200, sweep_json(*s, true));
               }});
   router.add({"GET", "/api/sweeps/{id}/points", Role::viewer,
-              "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv.",
+              "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv; ?offset=&limit= pages them "
+              "(at most 10000 a page; X-Total-Count gives the total).",
               worker.offload([db_path](const Request& req) {
                 Response err;
                 const auto id = sweep_id(req, err);
                 if (!id) return err;
                 const auto format = format_of(req, err);
                 if (!format) return err;
+                const auto page = page_of(req, err);
+                if (!page) return err;
                 db::Store* own = thread_store(db_path, err);
                 if (!own) return err;
                 if (auto s = own->get_sweep(*id); !s) return db_error(s.error());
                 auto rows = own->points(*id);
                 if (!rows) return db_error(rows.error());
+                const std::span<const db::PointRow> all(*rows);
+                const std::size_t first = std::min(page->offset, all.size());
+                const auto slice = all.subspan(first, std::min(page->limit, all.size() - first));
                 Response r;
                 if (*format == "csv") {
                   r.content_type = "text/csv; charset=utf-8";
-                  r.body = db::points_to_csv(*rows);
+                  r.body = db::points_to_csv(slice);
                 } else {
-                  r.body = db::points_to_json(*rows).dump();
+                  r.body = dump_json(db::points_to_json(slice));
                 }
+                r.headers.emplace_back("X-Total-Count", std::to_string(all.size()));
                 return r;
               })});
   router.add({"GET", "/api/sweeps/{id}/analysis", Role::viewer,
@@ -232,7 +269,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   r.content_type = "text/csv; charset=utf-8";
                   r.body = bench::analysis_curves_csv(analysis);
                 } else {
-                  r.body = bench::to_json(analysis).dump();
+                  r.body = dump_json(bench::to_json(analysis));
                 }
                 return r;
               })});
@@ -242,8 +279,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 const auto add = [&out](std::string_view name, const char* description, const bench::SweepPlan& p) {
                   out.push_back({{"name", std::string(name)},
                                  {"description", description},
-                                 {"plan", nlohmann::json::parse(bench::to_json(p).dump())},
-                                 {"estimate", nlohmann::json::parse(bench::to_json(bench::estimate(p)).dump())}});
+                                 {"plan", nlohmann::json::parse(dump_json(bench::to_json(p)))},
+                                 {"estimate", nlohmann::json::parse(dump_json(bench::to_json(bench::estimate(p))))}});
                 };
                 add(bench::kThesisGridPreset,
                     "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, encoder/CAPWM",
@@ -263,9 +300,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   return error_response(413, "too_large", "a viewer may estimate plans of at most " +
                                                               std::to_string(kViewerEstimatePoints) + " points");
                 const auto e = bench::estimate(*plan.plan);
-                nlohmann::json out = nlohmann::json::parse(bench::to_json(e).dump());
+                nlohmann::json out = nlohmann::json::parse(dump_json(bench::to_json(e)));
                 out["duration_s"] = e.bench_time_s;
-                out["plan"] = nlohmann::json::parse(bench::to_json(*plan.plan).dump());
+                out["plan"] = nlohmann::json::parse(dump_json(bench::to_json(*plan.plan)));
                 return json_response(200, out);
               }),
               nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});

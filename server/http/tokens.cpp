@@ -10,11 +10,11 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "drivers/json_file.hpp"
 #include "server/http/sha256.hpp"
 
 namespace synbench::http {
@@ -92,10 +92,17 @@ std::error_code TokenStore::load_locked() {
     entries_.clear();
     return {};
   }
-  std::ifstream in(file_);
-  if (!in) return std::make_error_code(std::errc::permission_denied);
-  const auto doc = nlohmann::json::parse(in, nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("tokens") || !doc["tokens"].is_array())
+  // Through the shared reader: a directory, a device, a huge or deeply nested file, bytes that
+  // are not UTF-8 or an overflowing number are a refusal, never an exception.
+  const drivers::JsonParsed read = drivers::read_json_file(file_);
+  if (!read.ok()) {
+    std::error_code type_ec;
+    if (std::filesystem::is_directory(file_, type_ec)) return std::make_error_code(std::errc::is_a_directory);
+    if (read.error.find(": cannot open: ") != std::string::npos) return std::make_error_code(std::errc::permission_denied);
+    return std::make_error_code(std::errc::invalid_argument);
+  }
+  const nlohmann::json& doc = read.doc;
+  if (!doc.is_object() || !doc.contains("tokens") || !doc["tokens"].is_array())
     return std::make_error_code(std::errc::invalid_argument);
   std::vector<TokenEntry> entries;
   for (const auto& t : doc["tokens"]) {
@@ -103,7 +110,10 @@ std::error_code TokenStore::load_locked() {
       return std::make_error_code(std::errc::invalid_argument);
     const auto role = parse_role(t["role"].get<std::string>());
     if (!role) return std::make_error_code(std::errc::invalid_argument);
-    entries.push_back({t["sha256"].get<std::string>(), *role, t.value("created", "")});
+    // value() would throw on a "created" that is not a string; the field is informative only.
+    const auto created = t.find("created");
+    entries.push_back({t["sha256"].get<std::string>(), *role,
+                       created != t.end() && created->is_string() ? created->get<std::string>() : std::string()});
   }
   entries_ = std::move(entries);
   loaded_mtime_ = std::filesystem::last_write_time(file_, ec);

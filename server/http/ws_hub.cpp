@@ -36,7 +36,7 @@ std::string telemetry_message(const BenchStatus& s, double sent_unix_ms) {
   j["voltage_limited"] = s.synrm ? nlohmann::json(s.synrm->voltage_limited) : null;
   j["lock_lost"] = s.synrm ? nlohmann::json(s.synrm->lock_lost) : null;
   j["fault"] = s.synrm ? nlohmann::json(std::string(drivers::fault_name(s.synrm->fault))) : null;
-  return j.dump();
+  return dump_json(j);
 }
 
 nlohmann::json sweep_json(const BenchStatus& s, std::optional<double> eta_s) {
@@ -49,11 +49,11 @@ nlohmann::json sweep_json(const BenchStatus& s, std::optional<double> eta_s) {
 std::string state_message(const BenchStatus& s) {
   nlohmann::json j = status_json(s);
   j["type"] = "state";
-  return j.dump();
+  return dump_json(j);
 }
 
 std::string event_message(const BenchEvent& e) {
-  return nlohmann::json{{"type", "event"}, {"seq", e.seq}, {"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}}.dump();
+  return dump_json(nlohmann::json{{"type", "event"}, {"seq", e.seq}, {"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
 }
 
 WsHub::WsHub(boost::asio::io_context& io, BenchRuntime& bench, const Router& router, Authenticator auth, std::string version,
@@ -97,7 +97,7 @@ std::size_t WsHub::session_count() const {
 std::string WsHub::sweep_message(const BenchStatus& s) const {
   std::lock_guard lock(mutex_);
   const bool tracked = s.sweep && s.sweep->id == eta_sweep_id_ && s.sweep->state == "running";
-  return sweep_json(s, tracked ? eta_s_ : std::nullopt).dump();
+  return dump_json(sweep_json(s, tracked ? eta_s_ : std::nullopt));
 }
 
 void WsHub::on_tick() {

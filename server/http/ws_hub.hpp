@@ -29,6 +29,9 @@ struct WsLimits {
   std::size_t max_message_bytes = 64 * 1024;       // a bigger client message closes with 1009
   std::size_t max_queue_messages = 256;            // per session; beyond, the client is dropped
   std::size_t max_queue_bytes = 1 << 20;           // likewise
+  // A request's reply bigger than this is answered 413 `reply_too_large` instead: one message
+  // near max_queue_bytes would drop the client that asked for it.
+  std::size_t max_reply_bytes = 512 * 1024;
   std::chrono::milliseconds write_stall{5000};     // one write in flight longer: dropped
   std::chrono::milliseconds auth_timeout{5000};    // for the first message, {"op":"auth"}
   // The kernel's send buffer of a session's socket. Bounded so a reader that stalls fills it in

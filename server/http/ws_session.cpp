@@ -10,6 +10,8 @@
 
 #include <boost/asio/post.hpp>
 
+#include "drivers/json_file.hpp"
+#include "drivers/utf8.hpp"
 #include "server/http/api_routes.hpp"
 
 namespace synbench::http {
@@ -114,22 +116,24 @@ void WsSession::on_read(beast::error_code ec, std::size_t) {
       if (!identity_) refuse("the first message must be a text frame {\"op\":\"auth\",\"token\":...}");
       else bad_message("message: binary frames are not accepted; send JSON text");
     } else {
-      handle(text);
+      // An exception must not leave this handler: it would end the io loop for every client.
+      try {
+        handle(text);
+      } catch (const std::exception& e) {
+        std::cerr << "synbench serve: websocket message failed: " << drivers::escape_invalid_utf8(e.what()) << "\n";
+        bad_message("message: the daemon failed to handle it (" + drivers::escape_invalid_utf8(e.what()) + ")");
+      }
     }
   }
   if (!dropped_) do_read();
 }
 
 void WsSession::handle(const std::string& text) {
-  nlohmann::json doc;
-  std::string parse_error;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    parse_error = e.what();
-    const auto bracket = parse_error.find("] ");
-    if (bracket != std::string::npos) parse_error = parse_error.substr(bracket + 2);
-  }
+  // The shared reader: bytes that are not UTF-8, deep nesting and overflowing numbers are a
+  // reason ("not valid UTF-8 at byte 3"), never an exception.
+  drivers::JsonParsed parsed = drivers::parse_json_text(text);
+  const std::string parse_error = parsed.error;
+  const nlohmann::json& doc = parsed.doc;
   std::string op;
   if (parse_error.empty() && doc.is_object() && doc.contains("op") && doc["op"].is_string()) op = doc["op"].get<std::string>();
 
@@ -137,7 +141,7 @@ void WsSession::handle(const std::string& text) {
     if (op != "auth") return refuse("the first message must be {\"op\":\"auth\",\"token\":...}");
     return handle_auth(doc);
   }
-  if (!parse_error.empty()) return bad_message("message: not JSON: " + parse_error);
+  if (!parse_error.empty()) return bad_message("message: " + parse_error);
   if (!doc.is_object()) return bad_message("message: must be a JSON object");
   if (!doc.contains("op")) return bad_message("op: required");
   if (op.empty()) return bad_message("op: must be a non-empty string");
@@ -213,7 +217,7 @@ void WsSession::handle_request(const nlohmann::json& doc) {
     return bad_message("path: required, starting with / (such as \"/api/bench/status\")");
   const nlohmann::json id = doc.contains("id") ? doc["id"] : nlohmann::json(nullptr);
   std::string body;
-  if (doc.contains("body")) body = doc["body"].dump();
+  if (doc.contains("body")) body = dump_json(doc["body"]);
   // Through the REST router with this session's token: the same roles, lock and validation. A
   // bench command answers from the bench thread: the reply comes back to this session's strand.
   hub_->router().dispatch_async(doc["method"].get<std::string>(), doc["path"].get<std::string>(), "Bearer " + token_,
@@ -223,14 +227,38 @@ void WsSession::handle_request(const nlohmann::json& doc) {
 }
 
 void WsSession::reply(const nlohmann::json& id, const Response& r) {
-  nlohmann::json reply_body = r.body;  // a text body (metrics, CSV) stays a string
-  if (r.content_type.rfind("application/json", 0) == 0) {
-    try {
-      reply_body = nlohmann::json::parse(r.body);
-    } catch (const nlohmann::json::parse_error&) {
+  // A reply over the limit would overflow the send queue and drop the client: it is answered
+  // with an error naming the way to get it in pieces instead.
+  const std::size_t max = hub_->limits().max_reply_bytes;
+  const auto too_large = [&](std::size_t bytes) {
+    send(nlohmann::json{{"type", "reply"}, {"id", id}, {"status", 413},
+                        {"body", {{"error", {{"code", "reply_too_large"},
+                                             {"message", "the reply is " + std::to_string(bytes) + " bytes, over the WebSocket's " +
+                                                             std::to_string(max) + "-byte limit: ask for less (the points route "
+                                                             "pages with ?offset=&limit=) or use REST"}}}}}});
+  };
+  if (r.body.size() > max) return too_large(r.body.size());
+  try {
+    nlohmann::json reply_body = r.body;  // a text body (metrics, CSV) stays a string
+    if (r.content_type.rfind("application/json", 0) == 0) {
+      drivers::JsonParsed parsed = drivers::parse_json_text(r.body);
+      if (parsed.ok()) reply_body = std::move(parsed.doc);
     }
+    nlohmann::json message{{"type", "reply"}, {"id", id}, {"status", r.status}, {"body", std::move(reply_body)}};
+    if (!r.headers.empty()) {
+      // Response headers a client may need (X-Total-Count of a page, Allow of a 405).
+      nlohmann::json headers = nlohmann::json::object();
+      for (const auto& [k, v] : r.headers) headers[k] = v;
+      message["headers"] = std::move(headers);
+    }
+    auto text = std::make_shared<const std::string>(dump_json(message));
+    if (text->size() > max) return too_large(text->size());
+    send(std::move(text));
+  } catch (const std::exception& e) {
+    std::cerr << "synbench serve: websocket reply failed: " << drivers::escape_invalid_utf8(e.what()) << "\n";
+    send(nlohmann::json{{"type", "reply"}, {"id", id}, {"status", 500},
+                        {"body", {{"error", {{"code", "internal"}, {"message", "the reply could not be built"}}}}}});
   }
-  send(nlohmann::json{{"type", "reply"}, {"id", id}, {"status", r.status}, {"body", std::move(reply_body)}});
 }
 
 void WsSession::bad_message(const std::string& message) {
@@ -275,7 +303,7 @@ void WsSession::on_tick(const HubTick& tick) {
     for (const auto& e : tick.events) send(e);
 }
 
-void WsSession::send(const nlohmann::json& message) { send(std::make_shared<const std::string>(message.dump())); }
+void WsSession::send(const nlohmann::json& message) { send(std::make_shared<const std::string>(dump_json(message))); }
 
 void WsSession::send(SharedText message) {
   if (dropped_ || closing_) return;

@@ -88,6 +88,47 @@ code, out, err = run("point", "--speed-rpm", "1200", "--load-Nm", "1", "--angle-
 check(code == 2 and "--speed-rpm" in err and "1000" in err, "the configured maximum speed applies")
 os.unlink(f.name)
 
+# Files no loader may abort on (issue "A daemon no input can crash"): each command exits 2 naming
+# the file and the reason, whatever the file holds or is.
+hostile_dir = tempfile.mkdtemp(prefix="synbench-cli-hostile-")
+def hostile_file(name, data):
+    path = os.path.join(hostile_dir, name)
+    with open(path, "wb") as f:
+        f.write(data)
+    return path
+a_directory = os.path.join(hostile_dir, "a-directory.json")
+os.mkdir(a_directory)
+twin_files = [
+    ("number overflow", hostile_file("overflow.json", b'{"thermal": {"ambient_C": 1e309}}')),
+    ("number overflow", hostile_file("digits.json", b'{"thermal": {"ambient_C": ' + b"9" * 400 + b"}}")),
+    ("nested deeper than 64 levels", hostile_file("deep.json", b"[" * 100000)),
+    ("not valid UTF-8 at byte 20", hostile_file("utf8.json", b'{"thermal": {"_c": "' + bytes([0xFF]) + b'"}}')),
+    ("a directory, not a regular file", a_directory),
+    ("cannot read", "/proc/self/mem"),
+    ("a character device, not a regular file", "/dev/zero"),
+]
+for reason, path in twin_files:
+    code, out, err = run("config", "--check", path)
+    check(code == 2 and path in err and reason in err,
+          f"config --check {os.path.basename(path)}: exit 2, {reason} ({code}: {err.strip()[:160]})")
+plan_overflow = hostile_file("plan.json", b'{"preset": "thesis-grid", "window_s": 1e309}')
+for path, reason in ((plan_overflow, "number overflow"), (a_directory, "a directory")):
+    code, out, err = run("sweep", path, "--db", os.path.join(hostile_dir, "x.db"), "--quiet")
+    check(code == 2 and path in err and reason in err, f"sweep {os.path.basename(path)}: exit 2, {reason} ({code}: {err.strip()[:160]})")
+bench_twin = json.load(open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "../../config/bench-twin.json")))
+for profile, reason in (("/proc/self/mem", "cannot read"), (a_directory, "a directory"), ("/dev/zero", "character device")):
+    doc = json.loads(json.dumps(bench_twin))
+    doc["devices"]["vfc_meter"]["profile"] = profile
+    path = hostile_file("bench-%d.json" % len(reason), json.dumps(doc).encode())
+    code, out, err = run("bench", "status", "--bench", path)
+    check(code == 2 and profile in err and reason in err, f"bench status with the profile {profile}: exit 2, {reason} ({code}: {err.strip()[:200]})")
+bench_overflow = hostile_file("bench-overflow.json", json.dumps(bench_twin).replace('"links"', '"retries": 1e999, "links"').encode())
+code, out, err = run("point", "--speed-rpm", "500", "--load-Nm", "1", "--angle-deg", "50", "--bench", bench_overflow)
+check(code == 2 and bench_overflow in err and "number overflow" in err, f"point --bench with 1e999: exit 2 ({code}: {err.strip()[:200]})")
+serve_overflow = hostile_file("serve.json", b'{"listen": 1e309}')
+code, out, err = run("serve", "--config", serve_overflow, "--data-dir", os.path.join(hostile_dir, "data"))
+check(code == 2 and serve_overflow in err and "number overflow" in err, f"serve --config with 1e309: exit 2 ({code}: {err.strip()[:200]})")
+
 # Below an EEMF observer's minimum speed (500 rpm) the drive runs on its fallback: the point is
 # measured and flagged; above it the observer gives the angle.
 for speed, below in (("300", True), ("700", False)):

@@ -140,6 +140,20 @@ def main():
         lines = data.decode().splitlines()
         check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("point_index")
               and len(lines) == 3, "points as CSV")
+        # Pages: ?offset=&limit=, the total in X-Total-Count; without them the whole (small) sweep.
+        s, data, r = d.request("GET", "/api/sweeps/1/points", token=viewer)
+        check(r.getheader("X-Total-Count") == "2", "points: X-Total-Count without paging")
+        s, data, r = d.request("GET", "/api/sweeps/1/points?offset=1&limit=1", token=viewer)
+        page = json.loads(data) if s == 200 else []
+        check(s == 200 and len(page) == 1 and page[0]["point_index"] == 1 and r.getheader("X-Total-Count") == "2",
+              "points ?offset=1&limit=1: the second point, total 2")
+        s, data, _ = d.request("GET", "/api/sweeps/1/points?offset=5", token=viewer)
+        check(s == 200 and json.loads(data) == [], "points past the end: an empty page")
+        s, data, r = d.request("GET", "/api/sweeps/1/points?format=csv&limit=1", token=viewer)
+        check(s == 200 and len(data.decode().splitlines()) == 2, "a CSV page: header and one row")
+        for q in ("limit=0", "limit=10001", "offset=-1", "limit=x", "offset=%ff"):
+            s, data, _ = d.request("GET", "/api/sweeps/1/points?" + q, token=viewer)
+            check(s == 400 and error_of(data)[0] == "bad_field", "points ?%s -> 400 bad_field (got %d)" % (q, s))
         # Analysis of the stored sweep, JSON and CSV.
         s, data, _ = d.request("GET", "/api/sweeps/1/analysis", token=viewer)
         an = json.loads(data)
@@ -247,6 +261,39 @@ def main():
         check(s == 200, "Host localhost:PORT accepted")
         s, _, _ = d.request("GET", "/api/health", host="127.0.0.1:1")
         check(s == 403, "Host with another port -> 403")
+        # Two Host headers (both allowed or not): 400, never a pick of one.
+        for second in ("127.0.0.1:%d" % d.port, "evil.example"):
+            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
+            raw.sendall(("GET /api/health HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: %s\r\nConnection: close\r\n\r\n"
+                         % (d.port, second)).encode())
+            reply = b""
+            while True:
+                chunk = raw.recv(4096)
+                if not chunk:
+                    break
+                reply += chunk
+            raw.close()
+            check(reply.startswith(b"HTTP/1.1 400") and b"more than one Host" in reply, "duplicate Host (%s) -> 400" % second)
+        # A path or parameter that is not UTF-8: a JSON answer, never a crash.
+        for path, status in (("/api/\xff", 404), ("/\xff.js", 404), ("/api/sweeps/%ff", 400), ("/api/sweeps/1/points?format=%ff", 400)):
+            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
+            raw.sendall(b"GET " + path.encode("latin-1") + ("" " HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nAuthorization: Bearer %s\r\n"
+                                                           "Connection: close\r\n\r\n" % (d.port, viewer)).encode())
+            reply = b""
+            while True:
+                chunk = raw.recv(4096)
+                if not chunk:
+                    break
+                reply += chunk
+            raw.close()
+            head, _, body = reply.partition(b"\r\n\r\n")
+            try:
+                doc = json.loads(body.decode("utf-8"))
+            except ValueError:
+                doc = None
+            check(head.startswith(b"HTTP/1.1 %d" % status) and doc is not None and "error" in doc,
+                  "GET %r -> %d with a JSON error (got %r)" % (path, status, reply[:120]))
+            check(d.proc.poll() is None, "the daemon survives GET %r" % path)
         s, data, _ = d.request("POST", "/api/bench/setpoints", body="x" * (65 * 1024), token=op)
         check(s == 413 and error_of(data)[0] == "body_too_large", "body over the limit -> 413")
         s, data, _ = d.request("POST", "/api/bench/setpoints", body='{"speed_rpm": ', token=op)

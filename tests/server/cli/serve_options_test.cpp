@@ -102,7 +102,7 @@ TEST(ServeOptions, ErrorsNameTheirSource) {
   const auto typed = write_file("typed.json", R"({"allow_hosts": ["ok.lab:1", 5]})");
   EXPECT_NE(error_of({"--config", typed.string()}).find("/allow_hosts/1"), std::string::npos);
   const auto bad_json = write_file("bad.json", R"({"listen": )");
-  EXPECT_NE(error_of({"--config", bad_json.string()}).find("not JSON"), std::string::npos);
+  EXPECT_NE(error_of({"--config", bad_json.string()}).find("not valid JSON"), std::string::npos);
   const auto bad_twin = write_file("bad_twin.json", R"({"twin": {"firmware": {"max_speed_rpm": -5}}})");
   const auto e2 = error_of({"--config", bad_twin.string()});
   EXPECT_NE(e2.find("/twin"), std::string::npos) << e2;

@@ -18,6 +18,10 @@ Router make_router() {
   r.add({"POST", "/api/things/{id}/start", Role::operator_, "start a thing",
          [](const Request& q) { return json_response(200, {{"id", q.params.at("id")}, {"role", role_name(q.caller)}}); }});
   r.add({"POST", "/api/boom", Role::operator_, "throws", [](const Request&) -> Response { throw std::runtime_error("kaput"); }});
+  r.add({"POST", "/api/async-boom", Role::operator_, "throws before answering",
+         AsyncHandler([](const Request&, Reply) { throw std::runtime_error("kaput \xFF"); })});
+  r.add({"GET", "/api/echo", Role::anyone, "echoes bytes into JSON",
+         [](const Request&) { return json_response(200, {{"text", std::string("a\xFF" "b")}}); }});
   return r;
 }
 
@@ -72,6 +76,38 @@ TEST(Router, HandlerExceptionIs500JsonError) {
   const auto res = r.dispatch("POST", "/api/boom", "Bearer op", "");
   EXPECT_EQ(res.status, 500);
   EXPECT_EQ(body(res)["error"]["code"], "internal");
+}
+
+TEST(Router, AnAsyncHandlerThatThrowsIsOne500) {
+  const Router r = make_router();
+  const auto res = r.dispatch("POST", "/api/async-boom", "Bearer op", "");
+  EXPECT_EQ(res.status, 500);
+  EXPECT_NE(body(res)["error"]["message"].get<std::string>().find("kaput \\xFF"), std::string::npos) << res.body;
+}
+
+// Bytes that are not UTF-8, in the path, a path parameter, the query or a handler's own JSON:
+// always a valid JSON answer, a 400 naming the parameter where one is to blame.
+TEST(Router, BytesThatAreNotUtf8NeverBreakTheAnswer) {
+  const Router r = make_router();
+  const auto path = r.dispatch("GET", "/api/\xFF", "", "");
+  EXPECT_EQ(path.status, 404);
+  EXPECT_EQ(body(path)["error"]["message"], "no route for /api/\\xFF");
+  const auto param = r.dispatch("GET", "/api/things/%ff", "Bearer view", "");
+  EXPECT_EQ(param.status, 400);
+  EXPECT_EQ(body(param)["error"]["message"], "id: not valid UTF-8");
+  const auto raw_param = r.dispatch("GET", "/api/things/\xC3", "Bearer view", "");
+  EXPECT_EQ(raw_param.status, 400);
+  const auto query = r.dispatch("GET", "/api/things/1?format=%C3%28", "Bearer view", "");
+  EXPECT_EQ(query.status, 400);
+  EXPECT_EQ(body(query)["error"]["message"], "format: not valid UTF-8");
+  const auto name = r.dispatch("GET", "/api/things/1?%ff=1", "Bearer view", "");
+  EXPECT_EQ(name.status, 400);
+  EXPECT_EQ(body(name)["error"]["code"], "bad_field");
+  const auto echo = r.dispatch("GET", "/api/echo", "", "");
+  EXPECT_EQ(echo.status, 200);
+  EXPECT_EQ(body(echo)["text"], "a\xEF\xBF\xBD" "b");  // U+FFFD
+  // The 404 and 401 come before the parameter check: no route, no token, no judgement.
+  EXPECT_EQ(r.dispatch("GET", "/api/things/%ff", "", "").status, 401);
 }
 
 TEST(Router, OpenApiListsEveryRouteWithRoleAndPathParameters) {
