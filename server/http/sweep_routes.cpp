@@ -137,6 +137,12 @@ constexpr std::size_t kViewerEstimatePoints = 100000;
 void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, Worker& worker,
                       std::filesystem::path db_path,
                       nlohmann::ordered_json bench_config) {
+  // The worker's connection is opened now, with the daemon's: opened on first use after the
+  // file was deleted, it would make a new, empty database instead of noticing the loss.
+  worker.post([db_path] {
+    Response ignored;
+    thread_store(db_path, ignored);
+  });
   db::Store* db = &store;
   BenchRuntime* runtime = &bench;
   ControlLock* lock = &control;

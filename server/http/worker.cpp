@@ -29,4 +29,6 @@ AsyncHandler Worker::offload(Handler handler) {
   };
 }
 
+void Worker::post(std::function<void()> job) { boost::asio::post(pool_, std::move(job)); }
+
 }  // namespace synbench::http

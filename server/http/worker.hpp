@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <functional>
 
 #include <boost/asio/thread_pool.hpp>
 
@@ -22,6 +23,8 @@ class Worker {
 
   // `handler` as a route handler that runs on the worker thread.
   AsyncHandler offload(Handler handler);
+  // Runs `job` on the worker thread (its set-up, e.g. the thread's own store connection).
+  void post(std::function<void()> job);
   // Stops taking work and waits for what runs.
   void stop() { pool_.join(); }
 
