@@ -11,7 +11,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -36,8 +35,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A fixed count, not a time budget, so every run tries the same inputs. A sanitized build is
+// about ten times slower; it gets the first fifth of them.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr std::size_t kInputs = 500;
+#else
 constexpr std::size_t kInputs = 2500;
-constexpr std::chrono::seconds kBudget{8};
+#endif
 
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -167,7 +171,6 @@ class LoadersFuzz : public ::testing::Test {
     for (const auto& s : loader.seeds) seeds.push_back(read_file(s));
     Mutator mutator(20261122);
     std::size_t tried = 0, crashes = 0;
-    const auto t0 = std::chrono::steady_clock::now();
     const auto feed = [&](const fs::path& p, const std::string& what) {
       ++tried;
       try {
@@ -183,13 +186,12 @@ class LoadersFuzz : public ::testing::Test {
       }
     };
     for (const auto& p : special) feed(p, p.string());
-    for (std::size_t i = 0; i < kInputs && std::chrono::steady_clock::now() - t0 < kBudget; ++i) {
+    for (std::size_t i = 0; i < kInputs; ++i) {
       std::ofstream(input, std::ios::binary | std::ios::trunc) << mutator.mutate(seeds[i % seeds.size()]);
       feed(input, "mutation " + std::to_string(i));
     }
     std::cout << loader.name << ": inputs tried " << tried << ", crashes " << crashes << ", 5xx 0" << std::endl;
     EXPECT_EQ(crashes, 0u) << loader.name;
-    EXPECT_GE(tried, 500u) << loader.name << ": too few inputs within the time budget";
   }
 
   fs::path dir_;
