@@ -1,20 +1,14 @@
 // The bench thread and its command queue; see bench_runtime.hpp.
 #include "app/bench_runtime.hpp"
 
-#include <sstream>
 
 #include "bench/load_ramp.hpp"
 #include "drivers/error.hpp"
+#include "drivers/number_text.hpp"
 
 namespace synbench::app {
 
 namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 Refusal device_error(const std::string& what, std::error_code ec) {
   return {Refused::device_error, what + ": " + ec.message()};
@@ -289,8 +283,8 @@ void BenchRuntime::set_setpoints(SetpointsUpdate update, Done done) {
         if (update.speed_rpm) setpoints_.speed_rpm = *update.speed_rpm;
         if (update.load_Nm) setpoints_.load_Nm = *update.load_Nm;
         if (update.angle_deg) setpoints_.angle_deg = *update.angle_deg;
-        event("setpoints", "speed " + fmt(setpoints_.speed_rpm) + " rpm, load " + fmt(setpoints_.load_Nm) + " Nm, angle " +
-                               fmt(setpoints_.angle_deg) + " deg");
+        event("setpoints", "speed " + drivers::format_number(setpoints_.speed_rpm) + " rpm, load " + drivers::format_number(setpoints_.load_Nm) + " Nm, angle " +
+                               drivers::format_number(setpoints_.angle_deg) + " deg");
         if (enabled_ && !stop_.active()) return apply_setpoints();
         return std::nullopt;
       },

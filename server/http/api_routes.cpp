@@ -4,6 +4,7 @@
 #include "server/http/info_routes.hpp"
 
 #include "drivers/json_file.hpp"
+#include "drivers/number_text.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -47,12 +48,6 @@ std::string join(const Names& names) {
   std::string out;
   for (const auto& n : names) out += (out.empty() ? "" : ", ") + std::string(n);
   return out;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 }  // namespace
@@ -333,8 +328,8 @@ void add_api_routes(Router& router, ApiContext ctx) {
                   const double x = v.get<double>();
                   const bool ok = std::isfinite(x) && (f.open ? (x > f.lo && x < f.hi) : (x >= f.lo && x <= f.hi));
                   if (!ok)
-                    return reply(bad_field(f.name, fmt(x) + " is outside " + (f.open ? "(" : "[") + fmt(f.lo) + ", " +
-                                                       fmt(f.hi) + (f.open ? ")" : "]")));
+                    return reply(bad_field(f.name, drivers::format_number(x) + " is outside " + (f.open ? "(" : "[") + drivers::format_number(f.lo) + ", " +
+                                                       drivers::format_number(f.hi) + (f.open ? ")" : "]")));
                   *f.value = x;
                 }
                 bench->set_setpoints(sp, answer(std::move(reply)));

@@ -14,6 +14,7 @@
 #include "server/http/connection_registry.hpp"
 #include "server/http/sign_in_log.hpp"
 #include "server/http/static_files.hpp"
+#include "server/http/url_text.hpp"
 #include "server/http/ws_hub.hpp"
 #include "server/http/ws_session.hpp"
 
@@ -40,12 +41,8 @@ std::set<std::string> allowed_hosts(const std::string& listen_host, std::uint16_
 
 std::set<std::string> allowed_origins(const std::set<std::string>& hosts, const std::vector<std::string>& extra) {
   std::set<std::string> out;
-  auto lower = [](std::string s) {
-    for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    return s;
-  };
-  for (const auto& h : hosts) out.insert("http://" + lower(h));
-  for (const auto& o : extra) out.insert(lower(o));
+  for (const auto& h : hosts) out.insert("http://" + ascii_lower(h));
+  for (const auto& o : extra) out.insert(ascii_lower(o));
   return out;
 }
 
@@ -72,11 +69,6 @@ void fail(beast::error_code ec, const char* what) {
       ec == net::error::eof || ec == net::error::connection_reset)
     return;
   std::cerr << "synbench serve: " << what << ": " << ec.message() << "\n";
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return s;
 }
 
 // The REST router's share of the paths; everything else but /ws is the dashboard's.
@@ -176,14 +168,14 @@ class Session : public std::enable_shared_from_this<Session> {
     if (req.count(bhttp::field::host) > 1) {
       // Two Host headers name two targets; RFC 9112 Sec. 3.2 asks for a 400.
       r = error_response(400, "bad_request", "more than one Host header");
-    } else if (!shared_->hosts.count(lower(host))) {
+    } else if (!shared_->hosts.count(ascii_lower(host))) {
       r = error_response(403, "host_not_allowed", "the Host header must name the listen address");
     } else if (path == "/ws" && shared_->hub) {
       const std::string origin(req[bhttp::field::origin]);
       if (!beast::websocket::is_upgrade(req)) {
         r = error_response(426, "upgrade_required", "/ws is a WebSocket endpoint (docs/api.md)");
         r.headers.emplace_back("Upgrade", "websocket");
-      } else if (req.count(bhttp::field::origin) && !shared_->origins.count(lower(origin))) {
+      } else if (req.count(bhttp::field::origin) && !shared_->origins.count(ascii_lower(origin))) {
         // A browser always sends Origin: a page from another site must not reach the bench with
         // a token it got hold of. Clients that are not browsers send none.
         r = error_response(403, "origin_not_allowed", "the Origin header is not an allowed origin (see --allow-origin)");
@@ -360,8 +352,7 @@ std::error_code HttpServer::listen(const std::string& host, std::uint16_t port) 
 }
 
 void HttpServer::set_extra_hosts(std::vector<std::string> hosts) {
-  for (auto& h : hosts)
-    for (char& c : h) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  for (auto& h : hosts) h = ascii_lower(h);
   shared_->extra_hosts = std::move(hosts);
 }
 

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "drivers/utf8.hpp"
+#include "server/http/url_text.hpp"
 
 namespace synbench::http {
 
@@ -72,30 +73,8 @@ std::vector<std::string_view> segments(std::string_view path) {
   return out;
 }
 
-int hex_value(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
-std::string decode(std::string_view s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '+') out.push_back(' ');
-    else if (s[i] == '%' && i + 2 < s.size() && hex_value(s[i + 1]) >= 0 && hex_value(s[i + 2]) >= 0) {
-      out.push_back(static_cast<char>(hex_value(s[i + 1]) * 16 + hex_value(s[i + 2])));
-      i += 2;
-    } else out.push_back(s[i]);
-  }
-  return out;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return out;
-}
+// A malformed escape leaves the text as sent: the parameter's own check then refuses it.
+std::string decode(std::string_view s) { return percent_decode(s, Plus::space).value_or(std::string(s)); }
 
 }  // namespace
 
@@ -133,7 +112,7 @@ void Router::add(Route route) { routes_.push_back(std::move(route)); }
 
 std::optional<Identity> Router::identify(std::string_view authorization) const {
   const std::size_t sp = authorization.find(' ');
-  if (sp == std::string_view::npos || lower(authorization.substr(0, sp)) != "bearer" || !auth_) return std::nullopt;
+  if (sp == std::string_view::npos || ascii_lower(authorization.substr(0, sp)) != "bearer" || !auth_) return std::nullopt;
   std::string_view token = authorization.substr(sp + 1);
   while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
   return auth_(token);
@@ -256,7 +235,7 @@ nlohmann::json Router::openapi(const std::string& title, const std::string& vers
   for (const Route& r : routes_) {
     nlohmann::json op;
     op["summary"] = r.summary;
-    op["operationId"] = lower(r.method) + r.pattern;
+    op["operationId"] = ascii_lower(r.method) + r.pattern;
     op["x-synbench-role"] = role_name(r.role);
     if (r.role != Role::anyone) op["security"] = nlohmann::json::array({{{"bearer", nlohmann::json::array()}}});
     else op["security"] = nlohmann::json::array();
@@ -276,7 +255,7 @@ nlohmann::json Router::openapi(const std::string& title, const std::string& vers
       responses["403"] = {{"description", std::string("the token's role is below ") + role_name(r.role)}};
     }
     op["responses"] = responses;
-    paths[r.pattern][lower(r.method)] = op;
+    paths[r.pattern][ascii_lower(r.method)] = op;
   }
   return {
       {"openapi", "3.0.3"},

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drivers/utf8.hpp"
+#include "server/http/url_text.hpp"
 
 namespace synbench::http {
 
@@ -29,19 +30,6 @@ the daemon with <code>--web-dir DIR</code> (or <code>SYNBENCH_WEB_DIR</code>) na
 </body></html>
 )";
 
-int hex_value(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-  return out;
-}
-
 Response plain_error(int status, const std::string& code, const std::string& message) {
   Response r = error_response(status, code, message);
   r.headers.emplace_back("Cache-Control", "no-store");
@@ -61,7 +49,7 @@ Response not_built() {
 // refused before decoding: after it they would be indistinguishable from separators.
 std::variant<std::vector<std::string>, std::string> split_path(std::string_view path) {
   if (path.empty() || path.front() != '/') return std::string("the path must start with /");
-  const std::string low = lower(path);
+  const std::string low = ascii_lower(path);
   if (low.find("%2f") != std::string::npos || low.find("%5c") != std::string::npos || path.find('\\') != std::string_view::npos)
     return std::string("encoded slashes and backslashes are not allowed in a path");
   std::vector<std::string> segs;
@@ -79,9 +67,9 @@ std::variant<std::vector<std::string>, std::string> split_path(std::string_view 
       continue;
     }
     if (c == '%') {
-      if (i + 2 >= path.size() || hex_value(path[i + 1]) < 0 || hex_value(path[i + 2]) < 0)
-        return std::string("malformed percent-encoding");
-      c = static_cast<char>(hex_value(path[i + 1]) * 16 + hex_value(path[i + 2]));
+      const auto decoded = percent_decode(path.substr(i, 3), Plus::literal);
+      if (!decoded) return std::string("malformed percent-encoding");
+      c = decoded->front();
       i += 2;
       if (c == '\0') return std::string("NUL in a path");
     }
@@ -139,7 +127,7 @@ std::string content_type_for(const fs::path& file) {
       {".csv", "text/csv; charset=utf-8"},
       {".wasm", "application/wasm"},
   };
-  const std::string ext = lower(file.extension().string());
+  const std::string ext = ascii_lower(file.extension().string());
   for (const auto& [e, t] : types)
     if (ext == e) return t;
   return "application/octet-stream";
@@ -185,7 +173,7 @@ Response StaticFiles::serve(std::string_view method, std::string_view target, st
 
   Response r;
   r.content_type = content_type_for(file);
-  const bool html = lower(file.extension().string()) == ".html";
+  const bool html = ascii_lower(file.extension().string()) == ".html";
   const std::string rel_file = fs::relative(file, root, ec).generic_string();
   if (html) {
     r.headers.emplace_back("Cache-Control", "no-store");

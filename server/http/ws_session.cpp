@@ -6,11 +6,11 @@
 #include <cmath>
 #include <iostream>
 #include <set>
-#include <sstream>
 
 #include <boost/asio/post.hpp>
 
 #include "drivers/json_file.hpp"
+#include "drivers/number_text.hpp"
 #include "drivers/utf8.hpp"
 #include "server/http/api_routes.hpp"
 
@@ -43,12 +43,6 @@ std::optional<std::string> unknown_field(const nlohmann::json& doc, const std::s
       return k + ": unknown field (expected: " + list + ")";
     }
   return std::nullopt;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 }  // namespace
@@ -189,7 +183,7 @@ void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
       if (!doc["rate_hz"].is_number()) return bad_message("rate_hz: must be a number");
       rate_hz = doc["rate_hz"].get<double>();
       if (!std::isfinite(rate_hz) || rate_hz <= 0 || rate_hz > lim.max_rate_hz)
-        return bad_message("rate_hz: " + fmt(rate_hz) + " is outside (0, " + fmt(lim.max_rate_hz) + "]");
+        return bad_message("rate_hz: " + drivers::format_number(rate_hz) + " is outside (0, " + drivers::format_number(lim.max_rate_hz) + "]");
     }
     const double hub_rate_hz = 1000.0 / static_cast<double>(WsHub::kPeriod.count());
     period_ticks_ = hub_rate_hz / rate_hz;
