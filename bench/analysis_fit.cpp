@@ -5,63 +5,46 @@
 #include <array>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 namespace synbench::bench {
 
 std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::span<const double> y) {
-  const std::size_t n = std::min(x.size(), y.size());
+  const auto n = static_cast<Eigen::Index>(std::min(x.size(), y.size()));
   if (n < 3) return std::nullopt;
   double mean = 0;
-  for (std::size_t i = 0; i < n; ++i) mean += x[i];
+  for (Eigen::Index i = 0; i < n; ++i) mean += x[static_cast<std::size_t>(i)];
   mean /= static_cast<double>(n);
-  // Normal equations in t = (x - mean) / spread, so the pivots stay comparable at ~50 deg.
+  // In t = (x - mean) / spread the columns stay comparable at angles around 50 deg.
   double spread = 0;
-  for (std::size_t i = 0; i < n; ++i) spread = std::max(spread, std::fabs(x[i] - mean));
+  for (Eigen::Index i = 0; i < n; ++i) spread = std::max(spread, std::fabs(x[static_cast<std::size_t>(i)] - mean));
   if (spread <= 0) return std::nullopt;
-  // [A | I | b], Gauss-Jordan: leaves A^-1 (for the vertex's variance) and the coefficients.
-  double m[3][7] = {};
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = (x[i] - mean) / spread;
-    const double phi[3] = {1, t, t * t};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) m[r][c] += phi[r] * phi[c];
-      m[r][6] += phi[r] * y[i];
-    }
+  Eigen::MatrixX3d phi(n, 3);
+  Eigen::VectorXd rhs(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = (x[static_cast<std::size_t>(i)] - mean) / spread;
+    phi.row(i) << 1, t, t * t;
+    rhs(i) = y[static_cast<std::size_t>(i)];
   }
-  for (int r = 0; r < 3; ++r) m[r][3 + r] = 1;
-  for (int col = 0; col < 3; ++col) {
-    int pivot = col;
-    for (int r = col + 1; r < 3; ++r)
-      if (std::fabs(m[r][col]) > std::fabs(m[pivot][col])) pivot = r;
-    // Fewer than three distinct abscissae make the system singular.
-    if (std::fabs(m[pivot][col]) < 1e-12 * static_cast<double>(n)) return std::nullopt;
-    for (int c = 0; c < 7; ++c) std::swap(m[col][c], m[pivot][c]);
-    const double d = m[col][col];
-    for (int c = 0; c < 7; ++c) m[col][c] /= d;
-    for (int r = 0; r < 3; ++r) {
-      if (r == col) continue;
-      const double f = m[r][col];
-      for (int c = 0; c < 7; ++c) m[r][c] -= f * m[col][c];
-    }
-  }
-  const double b0 = m[0][6], b1 = m[1][6], b2 = m[2][6];
+  // QR of the design matrix, never the normal equations: their condition number is its square.
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixX3d> qr(phi);
+  if (qr.rank() < 3) return std::nullopt;  // fewer than three distinct abscissae
+  const Eigen::Vector3d b = qr.solve(rhs);
   QuadraticFit fit;
   fit.q.x0 = mean;
-  fit.q.c0 = b0;
-  fit.q.c1 = b1 / spread;
-  fit.q.c2 = b2 / (spread * spread);
-  if (n > 3 && b2 > 0) {
-    double rss = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double e = y[i] - fit.q(x[i]);
-      rss += e * e;
-    }
-    const double s2 = rss / static_cast<double>(n - 3);
-    // Vertex t* = -b1 / (2 b2); its gradient with respect to (b0, b1, b2).
-    const double g[3] = {0, -1 / (2 * b2), b1 / (2 * b2 * b2)};
-    double var = 0;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) var += g[r] * m[r][3 + c] * g[c];
-    fit.vertex_se = spread * std::sqrt(std::max(0.0, s2 * var));
+  fit.q.c0 = b(0);
+  fit.q.c1 = b(1) / spread;
+  fit.q.c2 = b(2) / (spread * spread);
+  if (n > 3 && b(2) > 0) {
+    const double s2 = (phi * b - rhs).squaredNorm() / static_cast<double>(n - 3);
+    // (Phi^T Phi)^-1 = P R^-1 R^-T P^T from the pivoted QR.
+    const Eigen::Matrix3d r = qr.matrixR().topLeftCorner<3, 3>().triangularView<Eigen::Upper>();
+    const Eigen::Matrix3d r_inv = r.triangularView<Eigen::Upper>().solve(Eigen::Matrix3d::Identity());
+    const Eigen::Matrix3d p = qr.colsPermutation();
+    const Eigen::Matrix3d cov = p * r_inv * r_inv.transpose() * p.transpose();
+    // Vertex t* = -b1 / (2 b2); its gradient with respect to (b0, b1, b2) (the delta method).
+    const Eigen::Vector3d g(0, -1 / (2 * b(2)), b(1) / (2 * b(2) * b(2)));
+    fit.vertex_se = spread * std::sqrt(std::max(0.0, s2 * g.dot(cov * g)));
   }
   return fit;
 }

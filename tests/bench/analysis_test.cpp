@@ -81,6 +81,45 @@ TEST(AnalysisFit, InterpolationAndLeastSquares) {
   EXPECT_NEAR(se2 / se1, 2.0, 0.05);
 }
 
+// The vertex's standard error against the textbook computation done independently: normal
+// equations in raw x, their inverse by cofactors, the delta method on x* = -a1 / (2 a2).
+TEST(AnalysisFit, VertexStandardErrorMatchesTheDeltaMethod) {
+  const std::vector<double> x{44, 46, 48, 50, 52, 54, 56};
+  const std::vector<double> y{0.912, 0.921, 0.927, 0.929, 0.928, 0.922, 0.915};
+  double s[5] = {}, t[3] = {};
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int k = 0; k < 5; ++k) s[k] += std::pow(x[i], k);
+    for (int k = 0; k < 3; ++k) t[k] += std::pow(x[i], k) * y[i];
+  }
+  const double m[3][3] = {{s[0], s[1], s[2]}, {s[1], s[2], s[3]}, {s[2], s[3], s[4]}};
+  const auto cof = [&](int r, int c) {
+    const int r0 = (r + 1) % 3, r1 = (r + 2) % 3, c0 = (c + 1) % 3, c1 = (c + 2) % 3;
+    return m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+  };
+  const double det = m[0][0] * cof(0, 0) + m[0][1] * cof(0, 1) + m[0][2] * cof(0, 2);
+  double inv[3][3], a[3] = {};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) inv[r][c] = cof(c, r) / det;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a[r] += inv[r][c] * t[c];
+  double rss = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) rss += std::pow(y[i] - (a[0] + a[1] * x[i] + a[2] * x[i] * x[i]), 2);
+  const double s2 = rss / static_cast<double>(x.size() - 3);
+  const double g[3] = {0, -1 / (2 * a[2]), a[1] / (2 * a[2] * a[2])};
+  double var = 0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) var += g[r] * inv[r][c] * g[c];
+  // The data open downward (an efficiency maximum): fit the negated values, whose vertex and
+  // standard error are the same.
+  std::vector<double> neg;
+  for (double v : y) neg.push_back(-v);
+  const auto fit = fit_quadratic_se(x, neg);
+  ASSERT_TRUE(fit && fit->vertex_se);
+  EXPECT_NEAR(fit->q.vertex(), -a[1] / (2 * a[2]), 1e-6);
+  EXPECT_NEAR(*fit->vertex_se, std::sqrt(s2 * var), 1e-6 * std::sqrt(s2 * var) + 1e-9);
+  EXPECT_GT(*fit->vertex_se, 0.05);  // the data are noisy enough for a visible error
+}
+
 TEST(AnalysisFit, HistogramBinsAreAlignedToMultiplesOfTheWidth) {
   const auto bins = histogram_bins({-0.75, -0.5, -0.25, 0.0, 0.49, 0.5, 1.6}, 0.5);
   ASSERT_EQ(bins.size(), 6u);
