@@ -24,21 +24,6 @@ EkfBasic::EkfBasic(const EkfBasicParams& params) : params_(params) {
   reset();
 }
 
-void EkfBasic::reset() {
-  State x;
-  Cov p = Cov::Zero();
-  for (int i = 0; i < kN; ++i) {
-    x(i) = params_.x0[static_cast<std::size_t>(i)];
-    p(i, i) = params_.p0_diag[static_cast<std::size_t>(i)];
-  }
-  reset(x, p);
-}
-
-void EkfBasic::reset(const State& x, const Cov& p) {
-  x_ = x;
-  p_ = p;
-}
-
 EkfBasic::State EkfBasic::f(const State& x, double ts_s) {
   State y = x;
   y(kTh) += ts_s * x(kW);
@@ -89,25 +74,11 @@ void EkfBasic::update(const EstimatorInput& in) {
                 Eigen::Matrix<double, 1, 1>{innovation});
   }
 
-  x_(kRd) = std::max(x_(kRd), params_.min_reluctance_per_H);
-  x_(kRq) = std::max(x_(kRq), params_.min_reluctance_per_H);
-  if (params_.enforce_ld_above_lq && x_(kRd) > x_(kRq)) {
-    // (R'd, R'q, th) -> (R'q, R'd, th + pi/2): the same R'_phN for every phase.
-    std::swap(x_(kRd), x_(kRq));
-    x_(kTh) += 0.5 * std::numbers::pi;
-    p_.row(kRd).swap(p_.row(kRq));
-    p_.col(kRd).swap(p_.col(kRq));
-  }
+  // (R'd, R'q, th) -> (R'q, R'd, th + pi/2) gives the same R'_phN for every phase.
+  floor_and_order_reluctances(params_.min_reluctance_per_H, params_.enforce_ld_above_lq);
   x_(kTh) = wrap_pi(x_(kTh));
 }
 
-EstimatorOutput EkfBasic::output() const {
-  EstimatorOutput out;
-  out.theta_e_rad = wrap_pi(x_(kTh));
-  out.omega_e_rad_s = x_(kW);
-  out.ld_H = 1.0 / x_(kRd);
-  out.lq_H = 1.0 / x_(kRq);
-  return out;
-}
+EstimatorOutput EkfBasic::output() const { return core_output(); }
 
 }  // namespace synbench::emulator::firmware

@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include "emulator/firmware/estimators/ekf_core.hpp"
 #include "emulator/firmware/estimators/estimator.hpp"
 
 namespace synbench::emulator::firmware {
@@ -32,12 +33,14 @@ struct EkfBasicParams {
   std::array<double, 4> p0_diag{0.01, 0.01, 100.0, 1.0};
 };
 
-class EkfBasic final : public Estimator {
+namespace ekf_basic {
+enum Index : int { kRd = 0, kRq = 1, kW = 2, kTh = 3 };
+}
+
+class EkfBasic final : public Estimator, public EkfCore<4, ekf_basic::kRd, ekf_basic::kRq, ekf_basic::kW, ekf_basic::kTh> {
  public:
-  static constexpr int kN = 4;
-  enum Index : int { kRd = 0, kRq = 1, kW = 2, kTh = 3 };
-  using State = Eigen::Matrix<double, kN, 1>;
-  using Cov = Eigen::Matrix<double, kN, kN>;
+  using Index = ekf_basic::Index;
+  using enum ekf_basic::Index;
   using MeasRow = Eigen::Matrix<double, 1, kN>;
 
   explicit EkfBasic(const EkfBasicParams& params = {});
@@ -48,11 +51,9 @@ class EkfBasic final : public Estimator {
   // Angle wrapped to (-pi, pi]; Ld = 1/R'd, Lq = 1/R'q; no Rs.
   EstimatorOutput output() const override;
 
-  // Back to x0/P0 from the params, or to a given state and covariance.
-  void reset();
-  void reset(const State& x, const Cov& p);
-  const State& state() const { return x_; }
-  const Cov& covariance() const { return p_; }
+  // Back to x0/P0 from the params (EkfCore::reset(x, p): to a given state and covariance).
+  void reset() { reset_diagonal(params_.x0, params_.p0_diag); }
+  using EkfCore::reset;
   const EkfBasicParams& params() const { return params_; }
 
   // The model, public so tests can check the Jacobians against finite differences.
@@ -64,8 +65,6 @@ class EkfBasic final : public Estimator {
 
  private:
   EkfBasicParams params_;
-  State x_;
-  Cov p_;
   State q_diag_;
   double r_;
 };

@@ -107,21 +107,6 @@ EkfRs::EkfRs(const EkfRsParams& params) : params_(params) {
   reset();
 }
 
-void EkfRs::reset() {
-  State x;
-  Cov p = Cov::Zero();
-  for (int i = 0; i < kN; ++i) {
-    x(i) = params_.x0[static_cast<std::size_t>(i)];
-    p(i, i) = params_.p0_diag[static_cast<std::size_t>(i)];
-  }
-  reset(x, p);
-}
-
-void EkfRs::reset(const State& x, const Cov& p) {
-  x_ = x;
-  p_ = p;
-}
-
 EkfRs::State EkfRs::f(const State& x, double ualpha_V, double ubeta_V, double ts_s,
                       const FluxMaps* maps) {
   Rows3 rows;
@@ -260,22 +245,16 @@ void EkfRs::update(const EstimatorInput& in) {
                {kIalphaNonzero, kIbetaNonzero});
   }
 
-  x_(kRd) = std::max(x_(kRd), params_.min_reluctance_per_H);
-  x_(kRq) = std::max(x_(kRq), params_.min_reluctance_per_H);
   x_(kRs) = std::max(x_(kRs), params_.min_rs_ohm);
-  if (params_.enforce_ld_above_lq && x_(kRd) > x_(kRq)) {
-    // (R'd, R'q, i_d, i_q, th) -> (R'q, R'd, i_q, -i_d, th + pi/2): same f and h for the linear
-    // model. With flux maps the axes are no longer interchangeable in f, and the map is a
-    // re-labelling onto the convention the maps assume (it happens during the first
-    // milliseconds from the symmetric x0, before the currents carry information).
-    std::swap(x_(kRd), x_(kRq));
+  // (R'd, R'q, i_d, i_q, th) -> (R'q, R'd, i_q, -i_d, th + pi/2): same f and h for the linear
+  // model. With flux maps the axes are no longer interchangeable in f, and the map is a
+  // re-labelling onto the convention the maps assume (it happens during the first
+  // milliseconds from the symmetric x0, before the currents carry information).
+  if (floor_and_order_reluctances(params_.min_reluctance_per_H, params_.enforce_ld_above_lq)) {
     const double id_old = x_(kId);
     x_(kId) = x_(kIq);
     x_(kIq) = -id_old;
-    x_(kTh) += 0.5 * std::numbers::pi;
     // P <- J P J^T with J the signed permutation above.
-    p_.row(kRd).swap(p_.row(kRq));
-    p_.col(kRd).swap(p_.col(kRq));
     p_.row(kId).swap(p_.row(kIq));
     p_.col(kId).swap(p_.col(kIq));
     p_.row(kIq) *= -1.0;
@@ -285,11 +264,7 @@ void EkfRs::update(const EstimatorInput& in) {
 }
 
 EstimatorOutput EkfRs::output() const {
-  EstimatorOutput out;
-  out.theta_e_rad = wrap_pi(x_(kTh));
-  out.omega_e_rad_s = x_(kW);
-  out.ld_H = 1.0 / x_(kRd);
-  out.lq_H = 1.0 / x_(kRq);
+  EstimatorOutput out = core_output();
   out.rs_ohm = x_(kRs);
   return out;
 }

@@ -28,6 +28,7 @@
 
 #include <Eigen/Core>
 
+#include "emulator/firmware/estimators/ekf_core.hpp"
 #include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/flux_map.hpp"
 #include "emulator/twin_config.hpp"
@@ -54,12 +55,14 @@ struct EkfRsParams {
   std::array<double, 7> p0_diag{0.01, 0.01, 1.0, 1.0, 100.0, 1.0, 0.01};
 };
 
-class EkfRs final : public Estimator {
+namespace ekf_rs {
+enum Index : int { kRd = 0, kRq = 1, kId = 2, kIq = 3, kW = 4, kTh = 5, kRs = 6 };
+}
+
+class EkfRs final : public Estimator, public EkfCore<7, ekf_rs::kRd, ekf_rs::kRq, ekf_rs::kW, ekf_rs::kTh> {
  public:
-  static constexpr int kN = 7;
-  enum Index : int { kRd = 0, kRq = 1, kId = 2, kIq = 3, kW = 4, kTh = 5, kRs = 6 };
-  using State = Eigen::Matrix<double, kN, 1>;
-  using Cov = Eigen::Matrix<double, kN, kN>;
+  using Index = ekf_rs::Index;
+  using enum ekf_rs::Index;
   using Meas3 = Eigen::Vector3d;                    // [R'_phN, i_alpha, i_beta]
   using Jac3 = Eigen::Matrix<double, 3, kN>;
   using Meas2 = Eigen::Vector2d;                    // [i_alpha, i_beta]
@@ -74,11 +77,9 @@ class EkfRs final : public Estimator {
   // Angle wrapped to (-pi, pi]; Ld = 1/R'd, Lq = 1/R'q, Rs.
   EstimatorOutput output() const override;
 
-  // Back to x0/P0 from the params, or to a given state and covariance.
-  void reset();
-  void reset(const State& x, const Cov& p);
-  const State& state() const { return x_; }
-  const Cov& covariance() const { return p_; }
+  // Back to x0/P0 from the params (EkfCore::reset(x, p): to a given state and covariance).
+  void reset() { reset_diagonal(params_.x0, params_.p0_diag); }
+  using EkfCore::reset;
   const EkfRsParams& params() const { return params_; }
 
   // Flux of the back-EMF terms: the maps, or null for Psi = i / R'.
@@ -107,8 +108,6 @@ class EkfRs final : public Estimator {
 
   EkfRsParams params_;
   std::optional<FluxMaps> maps_;
-  State x_;
-  Cov p_;
   State q_diag_;       // with sigma_Rs
   double r_rph_, r_i_;
 };
