@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bench/pace.hpp"
+
 namespace synbench::bench {
 namespace {
 
@@ -235,9 +237,7 @@ SweepProgress SweepEngine::progress() const {
   }
   if (current_) p.current_index = current_->point.index;
   p.bench_elapsed_s = t0_ < 0 ? 0.0 : now_ - t0_;
-  if (measured_this_run_ > 0 && p.total >= p.done)
-    p.eta_s = p.bench_elapsed_s / static_cast<double>(measured_this_run_) *
-              static_cast<double>(p.total - p.done);
+  p.eta_s = remaining_s(p.bench_elapsed_s, measured_this_run_, p.done, p.total);
   return p;
 }
 

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "bench/analysis.hpp"
+#include "bench/pace.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
 #include "bench/sweep_plan.hpp"
@@ -93,9 +94,8 @@ class ProgressPrinter final : public bench::SweepSink {
     if (quiet_) return;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double frac = p.total ? static_cast<double>(p.done) / static_cast<double>(p.total) : 1.0;
-    std::string eta = "-";
-    if (stored_this_run_ > 0 && p.total >= p.done)
-      eta = hms(wall / static_cast<double>(stored_this_run_) * static_cast<double>(p.total - p.done));
+    const auto left_s = bench::remaining_s(wall, stored_this_run_, p.done, p.total);
+    const std::string eta = left_s ? hms(*left_s) : "-";
     if (tty_) {
       const int width = 30, fill = static_cast<int>(frac * width);
       std::fprintf(stderr, "\r[%s%s] %zu/%zu %3.0f%%  ETA %s  bench %s  %s   ",

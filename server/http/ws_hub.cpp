@@ -3,6 +3,7 @@
 
 #include <boost/asio/post.hpp>
 
+#include "bench/pace.hpp"
 #include "server/http/api_routes.hpp"
 #include "server/http/ws_session.hpp"
 
@@ -152,8 +153,8 @@ void WsHub::on_tick() {
         eta_t0_ = now;
         eta_s_.reset();
       } else if (s.sweep->done > eta_done0_) {
-        const double per_point_s = std::chrono::duration<double>(now - eta_t0_).count() / static_cast<double>(s.sweep->done - eta_done0_);
-        eta_s_ = per_point_s * static_cast<double>(s.sweep->total - std::min(s.sweep->total, s.sweep->done));
+        eta_s_ = bench::remaining_s(std::chrono::duration<double>(now - eta_t0_).count(), s.sweep->done - eta_done0_,
+                                    s.sweep->done, s.sweep->total);
       }
     }
   }
