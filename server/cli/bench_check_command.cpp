@@ -33,6 +33,7 @@ std::string addresses(const drivers::ProbeRow& r) {
 
 std::string raw_text(const drivers::ProbeRow& r) {
   if (r.raw.empty()) return "-";
+  if (drivers::is_bit_kind(r.table)) return std::to_string(r.raw[0]);  // a coil or discrete input: one bit
   std::string s;
   char word[8];
   for (const std::uint16_t w : r.raw) {

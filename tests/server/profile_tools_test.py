@@ -133,13 +133,14 @@ good = bench_config("good", far_side.tcp_link(1502))
 code, out, err = run("bench", "check", good)
 check(code == 0 and out.startswith(f"{good}: ok") and "synrm_drive: synbench SynRM drive" in out,
       f"bench check of a good config: {out.strip()} {err.strip()}")
-bad = bench_config("bad", {"transport": "tcp", "host": "127.0.0.1", "port": 70000},
-                   profiles={"synrm_drive": broken["a"][0]})
+bad = bench_config("bad", {"transport": "tcp", "host": "127.0.0.1", "port": 70000})
 code, out, err = run("bench", "check", bad)
-check(code == 1, f"bench check of a bad config exits 1 ({code})")
-check(f"{bad}: /links/emu/port: 70000 is outside" in out, f"names the config's pointer: {out.strip()}")
-check(f"{bad}: /devices/synrm_drive/profile: {broken['a'][0]} /signals/state/address: " in out,
-      "names the broken profile's file and pointer")
+check(code == 1 and f"{bad}: /links/emu/port: 70000 is outside" in out,
+      f"bench check of a bad config exits 1 naming the pointer: {out.strip()}")
+bad = bench_config("bad_profile", far_side.tcp_link(1502), profiles={"synrm_drive": broken["a"][0]})
+code, out, err = run("bench", "check", bad)
+check(code == 1 and f"{bad}: /devices/synrm_drive/profile: {broken['a'][0]} /signals/state/address: " in out,
+      f"a broken profile of a config: its file and pointer: {out.strip()[:300]}")
 clash = bench_config("clash", far_side.tcp_link(1502), units={"synrm_drive": 1, "load_drive": 1, "vfc_meter": 3})
 code, out, err = run("bench", "check", clash)
 check(code == 1 and f"{clash}: /devices/load_drive/profile: signal 'enable' (coil 0 at unit id 1) overlaps "
@@ -221,7 +222,7 @@ if code == 0:
     # measurement as on the default map, so it lies within the noise of the default map's point
     # over seeds (6 sigma), or 1e-4 relative where the noise is smaller than f32 rounding.
     tol = max(6 * sigma, 1e-4 * base)
-    check(abs(rec["efficiency"] - base) <= tol and rec["fault"] == "none",
+    check(abs(rec["efficiency"] - base) <= tol and rec["fault"] is None,
           f"remapped efficiency {rec['efficiency']:.6f} vs default map {base:.6f} (|d| "
           f"{abs(rec['efficiency'] - base):.2g} <= {tol:.2g}, sigma {sigma:.2g})")
 code, emu_out = emu.stop()
@@ -231,8 +232,8 @@ check(code == 0, "emulate --profiles stops on SIGTERM")
 pair = far_side.SocatPair(tmp, "probe")
 units = {"synrm_drive": 31, "load_drive": 32, "vfc_meter": 33}
 served = bench_config("served", far_side.tcp_link(1), profiles=remapped, units=units)
-emu = far_side.Emulator(BIN, os.path.join(tmp, "emulate_bench.log"), rtu=pair.a, args=["--bench", served])
-vendor_rtu = bench_config("vendor_rtu", far_side.rtu_link(pair.b), profiles=remapped, units=units, time_scale=1)
+emu = far_side.Emulator(BIN, os.path.join(tmp, "emulate_bench.log"), rtu=pair.a, args=["--bench", served, *SCALED])
+vendor_rtu = bench_config("vendor_rtu", far_side.rtu_link(pair.b), profiles=remapped, units=units)
 code, out, err = run("bench", "check", vendor_rtu, "--probe", timeout=120)
 check(code == 0 and "probe over rtu " in out and "signals read" in out,
       f"bench check --probe over RTU prints a table: {out.strip().splitlines()[-1:]} {err.strip()[:200]}")
@@ -255,6 +256,14 @@ check(temp.get("value") is not None and abs(temp["value"] - temp_far) < 0.5,
 check(far.coils(31, 500 + 0)[0] == 0 and far.holding(31, 500 + 0)[0] == 0,
       "the probe wrote nothing: enable coil and heartbeat still 0")
 far.close()
+code, out, err = run("point", *POINT, "--bench", vendor_rtu, timeout=90)
+check(code == 0, f"point --bench on the remapped bench over RTU (emulate --bench): {err.strip()[:300]}")
+if code == 0:
+    rec = json.loads(out)
+    tol = max(6 * sigma, 1e-4 * base)
+    check(abs(rec["efficiency"] - base) <= tol and rec["fault"] is None,
+          f"remapped efficiency over RTU {rec['efficiency']:.6f} vs default map {base:.6f} (|d| "
+          f"{abs(rec['efficiency'] - base):.2g} <= {tol:.2g})")
 emu.stop()
 pair.stop()
 
