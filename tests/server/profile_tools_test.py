@@ -11,6 +11,7 @@ Exit 77 (skipped) without socat."""
 import copy
 import json
 import os
+import re
 import shutil
 import statistics
 import struct
@@ -141,6 +142,13 @@ bad = bench_config("bad_profile", far_side.tcp_link(1502), profiles={"synrm_driv
 code, out, err = run("bench", "check", bad)
 check(code == 1 and f"{bad}: /devices/synrm_drive/profile: {broken['a'][0]} /signals/state/address: " in out,
       f"a broken profile of a config: its file and pointer: {out.strip()[:300]}")
+CONFIGS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "config")
+for name in ("bench-emulate.json", "bench-twin.json"):
+    code, out, err = run("bench", "check", os.path.join(CONFIGS, name))
+    check(code == 0 and " ok\n" in out, f"the shipped config/{name} passes bench check: {out.strip()[:100]} {err.strip()}")
+code, out, err = run("bench", "check", os.path.join(CONFIGS, "bench-twin.json"), "--probe")
+check(code == 0 and "probe over twin" in out and re.search(r"^(\d+) of \1 signals read$", out, re.M),
+      f"the in-process twin's register map probed: {out.strip().splitlines()[-1:]}")
 clash = bench_config("clash", far_side.tcp_link(1502), units={"synrm_drive": 1, "load_drive": 1, "vfc_meter": 3})
 code, out, err = run("bench", "check", clash)
 check(code == 1 and f"{clash}: /devices/load_drive/profile: signal 'enable' (coil 0 at unit id 1) overlaps "
