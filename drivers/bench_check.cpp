@@ -19,6 +19,16 @@ const DeviceProfile& profile_of(const BenchProfiles& p, DeviceKind k) {
 
 }  // namespace
 
+std::optional<std::string> register_collision(const DeviceProfile& a, const DeviceProfile& b) {
+  for (const ProfileSignal& sb : b.signals)
+    for (const ProfileSignal& sa : a.signals)
+      if (sa.unit_id == sb.unit_id && sa.kind == sb.kind && sa.address <= sb.last_address() &&
+          sb.address <= sa.last_address())
+        return "signal '" + sb.name + "' (" + place(sb) + ") overlaps " + std::string(name(a.kind)) + "'s signal '" +
+               sa.name + "' (" + place(sa) + ")";
+  return std::nullopt;
+}
+
 std::vector<ProfileError> check_bench(const BenchConfig& config, const BenchProfiles& profiles, bool one_endpoint) {
   std::vector<ProfileError> errors;
   for (std::size_t i = 0; i < kDeviceKinds.size(); ++i) {
@@ -27,23 +37,10 @@ std::vector<ProfileError> check_bench(const BenchConfig& config, const BenchProf
       const std::string& link = config.device(b).link;
       if (!one_endpoint && config.device(a).link != link) continue;
       // One collision per pair of devices is enough to name the problem.
-      for (const ProfileSignal& sb : profile_of(profiles, b).signals) {
-        const ProfileSignal* hit = nullptr;
-        for (const ProfileSignal& sa : profile_of(profiles, a).signals)
-          if (sa.unit_id == sb.unit_id && sa.kind == sb.kind && sa.address <= sb.last_address() &&
-              sb.address <= sa.last_address()) {
-            hit = &sa;
-            break;
-          }
-        if (!hit) continue;
+      if (const auto hit = register_collision(profile_of(profiles, a), profile_of(profiles, b)))
         errors.push_back({"/devices/" + std::string(name(b)) + "/profile",
-                          "signal '" + sb.name + "' (" + place(sb) + ") overlaps " + std::string(name(a)) +
-                              "'s signal '" + hit->name + "' (" + place(*hit) + ")" +
-                              (one_endpoint ? " on the one endpoint that serves them"
-                                            : " on link '" + link + "'") +
+                          *hit + (one_endpoint ? " on the one endpoint that serves them" : " on link '" + link + "'") +
                               ": give the devices different unit ids"});
-        break;
-      }
     }
   }
   // A serial port opened twice: the second open fails or, worse, both read each other's replies.

@@ -21,6 +21,7 @@
 #include "server/cli/args.hpp"
 #include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
+#include "server/cli/profile_problems.hpp"
 
 namespace synbench::cli {
 
@@ -115,18 +116,13 @@ void parse_endpoint(const std::string& text, std::string& host, std::uint16_t& p
 // "FILE: /pointer: reason; ..." for a UsageError.
 std::string problems(const std::vector<drivers::FileError>& errors) {
   std::string what;
-  for (const auto& e : errors) {
-    const bool names_file = e.error.path.empty() && e.error.reason.rfind(e.file + ":", 0) == 0;
-    what += (what.empty() ? "" : "; ") +
-            (names_file ? e.error.reason
-                        : e.file + ": " + (e.error.path.empty() ? "" : e.error.path + ": ") + e.error.reason);
-  }
+  for (const auto& e : errors) what += (what.empty() ? "" : "; ") + problem_text(e.file, e.error);
   return what;
 }
 
+// Every device is served on every endpoint: registers that collide anywhere collide here.
 std::vector<drivers::DeviceProfile> bench_profiles(const std::string& file) {
   LoadedBench b = load_bench_or_throw(file, "--bench");
-  // Every device is served on every endpoint: registers that collide anywhere collide here.
   std::vector<drivers::FileError> errors;
   for (auto& e : drivers::check_bench(b.config, b.profiles, true)) errors.push_back({file, std::move(e)});
   if (!errors.empty()) throw UsageError("--bench", problems(errors));
@@ -136,17 +132,12 @@ std::vector<drivers::DeviceProfile> bench_profiles(const std::string& file) {
 std::vector<drivers::DeviceProfile> dir_profiles(const std::string& dir) {
   drivers::ProfileDirResult r = drivers::load_profile_dir(dir);
   if (!r.profiles) throw UsageError("--profiles", problems(r.errors));
-  // Served on one endpoint: the same check as a bench config's devices on one link.
-  drivers::BenchConfig config;
-  drivers::BenchProfiles p{(*r.profiles)[0], (*r.profiles)[1], (*r.profiles)[2]};
-  std::vector<drivers::FileError> errors;
-  for (auto& e : drivers::check_bench(config, p, true)) {
-    const auto k = e.path.find("/devices/") == 0 ? e.path.substr(9, e.path.find('/', 9) - 9) : "";
-    const auto kind = drivers::parse_device_kind(k);
-    const std::size_t i = kind ? static_cast<std::size_t>(*kind) : 0;
-    errors.push_back({r.files[i].string(), {"", e.reason}});
-  }
-  if (!errors.empty()) throw UsageError("--profiles", problems(errors));
+  const auto& p = *r.profiles;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j)
+      if (const auto hit = drivers::register_collision(p[i], p[j]))
+        r.errors.push_back({r.files[j].string(), {"", *hit + ": the profiles are served on one endpoint"}});
+  if (!r.errors.empty()) throw UsageError("--profiles", problems(r.errors));
   return std::move(*r.profiles);
 }
 

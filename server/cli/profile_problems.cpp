@@ -3,14 +3,14 @@
 
 namespace synbench::cli {
 
+std::string problem_text(const std::string& file, const drivers::ProfileError& e) {
+  // A file that cannot be read or parsed is already named by the reader's own "FILE: reason".
+  if (e.path.empty() && e.reason.rfind(file + ":", 0) == 0) return e.reason;
+  return file + ": " + (e.path.empty() ? "" : e.path + ": ") + e.reason;
+}
+
 void print_problems(std::ostream& out, const std::string& file, const std::vector<drivers::ProfileError>& errors) {
-  for (const auto& e : errors) {
-    // A file that cannot be read or parsed is already named by the reader's own "FILE: reason".
-    if (e.path.empty() && e.reason.rfind(file + ":", 0) == 0)
-      out << e.reason << "\n";
-    else
-      out << file << ": " << (e.path.empty() ? "" : e.path + ": ") << e.reason << "\n";
-  }
+  for (const auto& e : errors) out << problem_text(file, e) << "\n";
 }
 
 std::string unit_ids(const drivers::DeviceProfile& p) {

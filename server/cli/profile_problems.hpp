@@ -12,6 +12,8 @@
 
 namespace synbench::cli {
 
+// One problem as "FILE: /pointer: reason".
+std::string problem_text(const std::string& file, const drivers::ProfileError& e);
 void print_problems(std::ostream& out, const std::string& file, const std::vector<drivers::ProfileError>& errors);
 
 // "1" or "1, 4": the unit ids a profile's signals use.

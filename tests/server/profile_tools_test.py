@@ -183,6 +183,16 @@ check(code == 2 and "--profiles" in err and "broken_a.json: /signals/state/addre
       f"emulate --profiles names a broken profile's file and pointer: {err.strip()[:300]}")
 code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--bench", clash)
 check(code == 2 and "--bench" in err and "overlaps" in err, f"emulate --bench refuses colliding devices: {err.strip()[:200]}")
+collide_dir = os.path.join(tmp, "collide")
+os.makedirs(collide_dir)
+for k in KINDS:
+    doc = load(k)
+    if k == "load_drive":
+        doc["unit_id"] = 1  # the SynRM drive's unit id, the same coils and registers
+    write(os.path.join(collide_dir, k + ".json"), doc)
+code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--profiles", collide_dir)
+check(code == 2 and f"{collide_dir}/load_drive.json: signal 'enable' (coil 0 at unit id 1) overlaps synrm_drive's" in err,
+      f"emulate --profiles refuses profiles whose registers collide: {err.strip()[:200]}")
 code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--bench", good, "--profiles", remap_dir)
 check(code == 2 and "not both" in err, "emulate --bench and --profiles together")
 
