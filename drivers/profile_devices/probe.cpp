@@ -4,6 +4,7 @@
 #include "drivers/profile_devices/probe.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string_view>
 
@@ -67,8 +68,8 @@ std::string decode_problem(DeviceKind kind, const ProfileSignal& s, const std::v
     v = raw[0];
   } else {
     RegisterEncoding open = s.encoding;
-    open.min = -INFINITY;
-    open.max = INFINITY;
+    open.min = -std::numeric_limits<double>::infinity();
+    open.max = std::numeric_limits<double>::infinity();
     if (decode_registers(open, raw, v)) return "the raw words are not a finite number";
     if (v < s.encoding.min || v > s.encoding.max)
       return number(v) + " is outside the profile's limits [" + number(s.encoding.min) + ", " +
