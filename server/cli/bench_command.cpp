@@ -1,4 +1,5 @@
-// `synbench bench`: the drives of a bench config from the command line, without the daemon:
+// `synbench bench`: a bench config and its drives from the command line, without the daemon:
+// `check` validates it and probes its devices (bench_check_command.cpp),
 // `status` reads both drives back, `reset` clears their latched faults (after an E-stop or a
 // watchdog trip) once it has seen that neither runs.
 #include <cstdio>
@@ -19,7 +20,7 @@ const char* const kBenchHelp = R"(usage: synbench bench check CONFIG [--probe] [
        synbench bench status --bench FILE [--json]
        synbench bench reset --bench FILE [--json]
 
-The drives of a bench config (docs/bench-config.md) from the command line, without the daemon.
+A bench config (docs/bench-config.md) and its devices from the command line, without the daemon.
 
   check    validates the config and the profiles it names: every problem as
            "FILE: /json/pointer: reason" (a profile's own problems name the profile file after
