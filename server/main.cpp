@@ -19,7 +19,8 @@ commands:
   config    print or check the twin's configuration
   emulate   serve the twin over Modbus TCP or RTU
   serve     run the daemon: REST API, WebSocket and dashboard over the twin or real drives
-  bench     read a bench config's drives, or clear their latched faults
+  bench     check a bench config and probe its devices, read its drives, clear their faults
+  profile   check device profiles
   token     create a bearer token for the daemon
 
   synbench <command> --help    options of a command
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
   if (command == "serve") return synbench::cli::serve_command(args);
   if (command == "token") return synbench::cli::token_command(args);
   if (command == "bench") return synbench::cli::bench_command(args);
+  if (command == "profile") return synbench::cli::profile_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

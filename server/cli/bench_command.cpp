@@ -1,4 +1,5 @@
-// `synbench bench`: the drives of a bench config from the command line, without the daemon:
+// `synbench bench`: a bench config and its drives from the command line, without the daemon:
+// `check` validates it and probes its devices (bench_check_command.cpp),
 // `status` reads both drives back, `reset` clears their latched faults (after an E-stop or a
 // watchdog trip) once it has seen that neither runs.
 #include <cstdio>
@@ -15,18 +16,28 @@
 
 namespace synbench::cli {
 
-const char* const kBenchHelp = R"(usage: synbench bench status --bench FILE [--json]
+const char* const kBenchHelp = R"(usage: synbench bench check CONFIG [--probe] [--json]
+       synbench bench status --bench FILE [--json]
        synbench bench reset --bench FILE [--json]
 
-The drives of a bench config (docs/bench-config.md) from the command line, without the daemon.
+A bench config (docs/bench-config.md) and its devices from the command line, without the daemon.
 
+  check    validates the config and the profiles it names: every problem as
+           "FILE: /json/pointer: reason" (a profile's own problems name the profile file after
+           the device's pointer), and what shows only when they are put together (two devices
+           on one link with the same unit id and overlapping registers, one serial port named by
+           two links). With --probe, connects over the config's links and reads every readable
+           signal of every device once (reads only, never a write), printing device, signal,
+           table, address(es), unit id, raw registers (hex) and the decoded value and unit, or
+           the signal's error. Exit 0 when valid (and, probing, every signal read), 1 otherwise
   status   reads both drives back: state, fault, speed, current, DC bus
   reset    clears the drives' latched faults (an E-stop's, a watchdog's), then reads them back.
            Sends the watchdog heartbeat first, so a drive's watchdog does not trip again at
            once. Refused while a drive reports running: it never starts anything
 
 options:
-  --bench FILE   bench config JSON (required)
+  --bench FILE   bench config JSON (required for status and reset; check takes it either way)
+  --probe        check: read every readable signal of every device once
   --json         one JSON object instead of the readable listing
   --help         this text
 
@@ -82,6 +93,7 @@ bool faulted(const bench::SafetySupervisor& s) {
 }  // namespace
 
 int bench_command(const std::vector<std::string>& argv) {
+  if (!argv.empty() && argv[0] == "check") return bench_check_command({argv.begin() + 1, argv.end()});
   std::optional<LoadedBench> loaded;
   std::string action;
   bool json = false;
@@ -92,7 +104,7 @@ int bench_command(const std::vector<std::string>& argv) {
       return 0;
     }
     if (a.positional().size() != 1 || (a.positional()[0] != "status" && a.positional()[0] != "reset"))
-      throw UsageError("ACTION", "give status or reset");
+      throw UsageError("ACTION", "give check, status or reset");
     action = a.positional()[0];
     json = a.has("--json");
     const auto file = a.text("--bench");

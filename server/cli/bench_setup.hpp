@@ -46,6 +46,8 @@ class ConfiguredBench {
 
   drivers::ProfileBench& bench() { return *bench_; }
   const drivers::ProfileBench& bench() const { return *bench_; }
+  // The bus of one of the config's links (`synbench bench check --probe` reads through it).
+  drivers::RegisterBus& bus(const std::string& link) { return *buses_.at(link); }
   // "tcp 127.0.0.1:1502", "twin (in-process)", ...: the links, for messages.
   std::string describe() const;
   // The last error of each link that had one, one per line.

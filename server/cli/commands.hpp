@@ -14,6 +14,8 @@ int emulate_command(const std::vector<std::string>& args);
 int serve_command(const std::vector<std::string>& args);
 int token_command(const std::vector<std::string>& args);
 int bench_command(const std::vector<std::string>& args);
+int bench_check_command(const std::vector<std::string>& args);  // `bench check ...`, after "check"
+int profile_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
@@ -22,5 +24,6 @@ extern const char* const kEmulateHelp;
 extern const char* const kServeHelp;
 extern const char* const kTokenHelp;
 extern const char* const kBenchHelp;
+extern const char* const kProfileHelp;
 
 }  // namespace synbench::cli

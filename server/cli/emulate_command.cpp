@@ -10,14 +10,18 @@
 #include <sstream>
 #include <thread>
 
+#include "drivers/bench_check.hpp"
 #include "drivers/profile/device_profile.hpp"
+#include "drivers/profile/profile_dir.hpp"
 #include "emulator/modbus/fault_injector.hpp"
 #include "emulator/modbus/rtu_server.hpp"
 #include "emulator/modbus/tcp_server.hpp"
 #include "emulator/modbus/twin_service.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
+#include "server/cli/bench_setup.hpp"
 #include "server/cli/commands.hpp"
+#include "server/cli/profile_problems.hpp"
 
 namespace synbench::cli {
 
@@ -25,9 +29,10 @@ const char* const kEmulateHelp = R"(usage: synbench emulate [--tcp HOST:PORT] [-
 
 Serves the bench's twin over Modbus as synbench's drive firmware would: the SynRM drive at unit
 id 1, the load drive at 2 and the VFC meter at 3, with the register maps of the default profiles
-(docs/register-map.md). The drives' watchdog stops both machines and latches fault 6 when the
-heartbeat stops changing; the fault_reset coil clears it; window_start opens a measurement
-window (shared by the three devices, as one trigger line). Runs until SIGINT or SIGTERM.
+(docs/register-map.md), or through other profiles (--profiles, --bench). The drives' watchdog
+stops both machines and latches fault 6 when the heartbeat stops changing; the fault_reset
+signal clears it; window_start opens a measurement window (shared by the three devices, as one
+trigger line). Runs until SIGINT or SIGTERM.
 
 links (at least one; given both, they serve the same twin: a bench on RTU, a test on TCP):
   --tcp HOST:PORT        Modbus TCP; port 0 picks a free port. Prints "listening on tcp HOST:PORT"
@@ -35,6 +40,14 @@ links (at least one; given both, they serve the same twin: a bench on RTU, a tes
                          (after the tcp line when both are given)
   --baud N               RTU baud rate (default 115200)
   --parity P             RTU parity: none (default), even, odd
+
+register maps (at most one; default: the default profiles, drivers/profiles/):
+  --profiles DIR         the profiles in DIR: every *.json there whose top level has a "kind" is a
+                         profile (others are skipped); exactly one synrm_drive, load_drive and
+                         vfc_meter profile. Their unit ids, addresses and encodings are served
+  --bench CONFIG         the three profiles a bench config names, at its unit ids (its links are
+                         not used: every device is served on each link given here, so their
+                         registers must not collide)
 
 twin:
   --time-scale X         X seconds of twin time per wall second, 0 < X <= 1000 (default 1);
@@ -55,7 +68,7 @@ fault hooks (for tests; docs/modbus.md; with both links, on both, counted togeth
   --fault-exception-pct P  percent of requests refused with exception 4 (not executed)
   --fault-corrupt-pct P  percent of replies corrupted (RTU: bad CRC; TCP: wrong transaction id)
   --fault-stuck LIST     signals that freeze at their next read: UNIT:SIGNAL[,UNIT:SIGNAL...],
-                         e.g. 1:speed_rpm,3:gate_sequence
+                         e.g. 1:speed_rpm,3:gate_sequence (UNIT: a unit id the profiles serve)
   --fault-cut-s S        on SIGUSR1, cut the link(s) for S seconds (default 2)
   --fault-seed N         seed of the fault draws (default 1)
   --help                 this text
@@ -100,6 +113,34 @@ void parse_endpoint(const std::string& text, std::string& host, std::uint16_t& p
   port = static_cast<std::uint16_t>(v);
 }
 
+// "FILE: /pointer: reason; ..." for a UsageError.
+std::string problems(const std::vector<drivers::FileError>& errors) {
+  std::string what;
+  for (const auto& e : errors) what += (what.empty() ? "" : "; ") + problem_text(e.file, e.error);
+  return what;
+}
+
+// Every device is served on every endpoint: registers that collide anywhere collide here.
+std::vector<drivers::DeviceProfile> bench_profiles(const std::string& file) {
+  LoadedBench b = load_bench_or_throw(file, "--bench");
+  std::vector<drivers::FileError> errors;
+  for (auto& e : drivers::check_bench(b.config, b.profiles, true)) errors.push_back({file, std::move(e)});
+  if (!errors.empty()) throw UsageError("--bench", problems(errors));
+  return {std::move(b.profiles.synrm_drive), std::move(b.profiles.load_drive), std::move(b.profiles.vfc_meter)};
+}
+
+std::vector<drivers::DeviceProfile> dir_profiles(const std::string& dir) {
+  drivers::ProfileDirResult r = drivers::load_profile_dir(dir);
+  if (!r.profiles) throw UsageError("--profiles", problems(r.errors));
+  const auto& p = *r.profiles;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size(); ++j)
+      if (const auto hit = drivers::register_collision(p[i], p[j]))
+        r.errors.push_back({r.files[j].string(), {"", *hit + ": the profiles are served on one endpoint"}});
+  if (!r.errors.empty()) throw UsageError("--profiles", problems(r.errors));
+  return std::move(*r.profiles);
+}
+
 std::vector<drivers::DeviceProfile> default_profiles() {
   std::vector<drivers::DeviceProfile> out;
   for (const drivers::DeviceKind k : drivers::kDeviceKinds) {
@@ -122,10 +163,11 @@ int emulate_command(const std::vector<std::string>& argv) {
   double time_scale = 1, cut_s = 2;
   std::optional<double> duration_s, watchdog_s;
   std::vector<std::pair<int, std::string>> stuck;
+  std::vector<drivers::DeviceProfile> profiles;
   try {
     Args a(argv, {"--help"},
            {"--tcp", "--rtu", "--baud", "--parity", "--time-scale", "--config", "--seed", "--udc-V", "--temp-C",
-            "--duration-s", "--watchdog-timeout-ms", "--fault-delay-pct", "--fault-delay-ms", "--fault-drop-pct", "--fault-exception-pct",
+            "--duration-s", "--watchdog-timeout-ms", "--profiles", "--bench", "--fault-delay-pct", "--fault-delay-ms", "--fault-drop-pct", "--fault-exception-pct",
             "--fault-corrupt-pct", "--fault-stuck", "--fault-cut-s", "--fault-seed"});
     if (a.has("--help")) {
       std::cout << kEmulateHelp;
@@ -159,6 +201,11 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (!(time_scale > 0) || time_scale > 1000)
       throw UsageError("--time-scale", fmt(time_scale) + " is outside (0, 1000]");
     if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+    const auto dir = a.text("--profiles");
+    const auto bench = a.text("--bench");
+    if (dir && bench) throw UsageError("--profiles", "give --profiles or --bench, not both");
+    if (dir) profiles = dir_profiles(*dir);
+    if (bench) profiles = bench_profiles(*bench);
     if (auto seed = a.number("--seed")) {
       if (*seed < 0 || *seed > 2147483647 || *seed != std::floor(*seed))
         throw UsageError("--seed", "must be a whole number in [0, 2147483647]");
@@ -207,9 +254,11 @@ int emulate_command(const std::vector<std::string>& argv) {
       while (std::getline(ss, item, ',')) {
         const auto colon = item.find(':');
         const std::string unit = colon == std::string::npos ? "" : item.substr(0, colon);
-        if (unit != "1" && unit != "2" && unit != "3")
-          throw UsageError("--fault-stuck", "'" + item + "' is not UNIT:SIGNAL with unit 1, 2 or 3");
-        stuck.emplace_back(std::stoi(unit), item.substr(colon + 1));
+        char* end = nullptr;
+        const long id = std::strtol(unit.c_str(), &end, 10);
+        if (unit.empty() || end != unit.c_str() + unit.size() || id < 1 || id > 247)
+          throw UsageError("--fault-stuck", "'" + item + "' is not UNIT:SIGNAL with a unit id 1..247");
+        stuck.emplace_back(static_cast<int>(id), item.substr(colon + 1));
       }
     }
   } catch (const UsageError& e) {
@@ -220,7 +269,7 @@ int emulate_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
-  emulator::TwinService service(config, default_profiles());
+  emulator::TwinService service(config, profiles.empty() ? default_profiles() : std::move(profiles));
   for (const auto& [unit, signal] : stuck) {
     const auto ec = service.locked([&](auto&, auto&, emulator::RegisterServer& server) {
       return server.stick(static_cast<std::uint8_t>(unit), signal);

@@ -1,0 +1,126 @@
+// Probing a device: one single-signal ReadPlan per readable signal, through a bus wrapper that
+// keeps the words the device answered, so the raw registers and the decoded value come from one
+// read and one decoding (SignalIo's), and a value that does not decode is shown with its words.
+#include "drivers/profile_devices/probe.hpp"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string_view>
+
+#include "drivers/profile/register_codec.hpp"
+#include "drivers/profile/signal_codes.hpp"
+#include "drivers/profile_devices/signal_io.hpp"
+
+namespace synbench::drivers {
+namespace {
+
+// Passes reads through and keeps the answer of the last one; refuses writes, so the probe
+// cannot write even by mistake.
+class RecordingBus final : public RegisterBus {
+ public:
+  explicit RecordingBus(RegisterBus& bus) : bus_(bus) {}
+
+  std::error_code read_bits(std::uint8_t unit_id, RegisterKind kind, std::uint16_t address,
+                            std::span<std::uint8_t> out) override {
+    last.clear();
+    const auto ec = bus_.read_bits(unit_id, kind, address, out);
+    if (!ec) last.assign(out.begin(), out.end());
+    return ec;
+  }
+  std::error_code read_registers(std::uint8_t unit_id, RegisterKind kind, std::uint16_t address,
+                                 std::span<std::uint16_t> out) override {
+    last.clear();
+    const auto ec = bus_.read_registers(unit_id, kind, address, out);
+    if (!ec) last.assign(out.begin(), out.end());
+    return ec;
+  }
+  std::error_code write_bits(std::uint8_t, std::uint16_t, std::span<const std::uint8_t>) override {
+    return make_error_code(errc::not_supported);
+  }
+  std::error_code write_registers(std::uint8_t, std::uint16_t, std::span<const std::uint16_t>) override {
+    return make_error_code(errc::not_supported);
+  }
+  BusStats stats() const override { return bus_.stats(); }
+  int last_exception_code() const override { return bus_.last_exception_code(); }
+  std::string last_error() const override { return bus_.last_error(); }
+  std::string name() const override { return bus_.name(); }
+
+  std::vector<std::uint16_t> last;
+
+ private:
+  RegisterBus& bus_;
+};
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Why words that arrived do not decode, found by decoding them again step by step without the
+// limits: the reason SignalIo's errc::protocol does not spell out.
+std::string decode_problem(DeviceKind kind, const ProfileSignal& s, const std::vector<std::uint16_t>& raw,
+                           std::error_code ec) {
+  double v = 0;
+  if (is_bit_kind(s.kind)) {
+    if (raw.empty() || raw[0] > 1) return "the device answered a bit that is neither 0 nor 1";
+    v = raw[0];
+  } else {
+    RegisterEncoding open = s.encoding;
+    open.min = -std::numeric_limits<double>::infinity();
+    open.max = std::numeric_limits<double>::infinity();
+    if (decode_registers(open, raw, v)) return "the raw words are not a finite number";
+    if (v < s.encoding.min || v > s.encoding.max)
+      return number(v) + " is outside the profile's limits [" + number(s.encoding.min) + ", " +
+             number(s.encoding.max) + "]";
+  }
+  double code = 0;
+  if (to_bench_code(kind, s, v, code)) return "device code " + number(v) + " has no label in the profile's values";
+  return "does not decode: " + ec.message();
+}
+
+std::string label_of(DeviceKind kind, const ProfileSignal& s, double code) {
+  if (!is_enumerated(kind, s)) return {};
+  const SignalSpec* spec = find_signal_spec(kind, s.name);
+  if (!spec || !(code >= 0) || code >= static_cast<double>(spec->labels.size()) || code != std::floor(code))
+    return "code " + number(code);
+  return std::string(spec->labels[static_cast<std::size_t>(code)]);
+}
+
+}  // namespace
+
+std::vector<ProbeRow> probe_device(RegisterBus& bus, const DeviceProfile& profile) {
+  RecordingBus recorder(bus);
+  SignalIo io(recorder, profile);
+  std::vector<ProbeRow> rows;
+  for (const ProfileSignal& s : profile.signals) {
+    if (!s.readable()) continue;
+    ProbeRow row;
+    row.device = profile.kind;
+    row.profile = profile.name;
+    row.signal = s.name;
+    row.table = s.kind;
+    row.address = s.address;
+    row.count = static_cast<std::uint16_t>(is_bit_kind(s.kind) ? 1 : address_width(s.encoding.type));
+    row.unit_id = s.unit_id;
+    row.unit = s.unit;
+    const std::string_view name = s.name;
+    const ReadPlan plan(profile, std::span<const std::string_view>(&name, 1));
+    double value = 0;
+    const auto ec = io.read(plan, std::span(&value, 1));
+    row.raw = recorder.last;
+    if (ec) {
+      // Words that arrived and do not decode, or a request that failed on the link.
+      row.error = row.raw.empty() ? (bus.last_error().empty() ? ec.message() : bus.last_error())
+                                  : decode_problem(profile.kind, s, row.raw, ec);
+    } else {
+      row.value = value;
+      row.label = label_of(profile.kind, s, value);
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace synbench::drivers
