@@ -45,9 +45,10 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["ld_err_pct"] = opt(r.ld_err_pct);
   j["lq_err_pct"] = opt(r.lq_err_pct);
   j["rs_err_pct"] = opt(r.rs_err_pct);
-  j["temp_C"] = r.temp_C;
+  j["temp_C"] = opt(r.temp_C);
   j["window_s"] = r.window_s;
   j["samples"] = r.samples;
+  j["window_source"] = drivers::keeper_name(r.window_source);
   j["settle_s"] = r.settle_s;
   j["voltage_limited"] = r.voltage_limited;
   j["unstable"] = r.unstable;

@@ -20,14 +20,14 @@ using bench::PointRecord;
 using Member = std::variant<double PointRecord::*, std::optional<double> PointRecord::*,
                             drivers::Estimator PointRecord::*, drivers::Pwm PointRecord::*,
                             std::uint32_t PointRecord::*, bool PointRecord::*,
-                            std::optional<std::string> PointRecord::*>;
+                            std::optional<std::string> PointRecord::*, drivers::WindowKeeper PointRecord::*>;
 
 struct RecordColumn {
   std::string_view name;
   Member member;
 };
 
-inline const std::array<RecordColumn, 38> kRecordColumns{{
+inline const std::array<RecordColumn, 39> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
@@ -59,6 +59,7 @@ inline const std::array<RecordColumn, 38> kRecordColumns{{
     {"temp_C", &PointRecord::temp_C},
     {"window_s", &PointRecord::window_s},
     {"samples", &PointRecord::samples},
+    {"window_source", &PointRecord::window_source},        // schema version 5
     {"settle_s", &PointRecord::settle_s},
     {"voltage_limited", &PointRecord::voltage_limited},
     {"unstable", &PointRecord::unstable},

@@ -18,6 +18,7 @@
 #include "db/store.hpp"
 #include "drivers/json_file.hpp"
 #include "app/bench_backend.hpp"
+#include "app/plan_needs.hpp"
 #include "app/supervised_point.hpp"
 #include "app/sweep_run.hpp"
 #include "emulator/twin_config_schema.hpp"
@@ -244,6 +245,10 @@ int sweep_command(const std::vector<std::string>& argv) {
 
   auto backend = make_backend(std::move(loaded), config);
   const app::BenchDescription& bench = backend->description();
+  if (auto unmet = app::unmet_plan_needs(*plan, bench)) {
+    std::cerr << "synbench sweep: refused before the start: " << *unmet << "\n";
+    return 1;
+  }
   bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [&](const std::string& k, const std::string& m) {
     (void)store.add_event(id, k == "fault" || k == "alarm" ? db::EventKind::fault : db::EventKind::state, m);
     if (!quiet && k == "alarm") std::cerr << "ALARM: " << m << "\n";
