@@ -59,7 +59,6 @@ inline const std::array<RecordColumn, 39> kRecordColumns{{
     {"temp_C", &PointRecord::temp_C},
     {"window_s", &PointRecord::window_s},
     {"samples", &PointRecord::samples},
-    {"window_source", &PointRecord::window_source},        // schema version 5
     {"settle_s", &PointRecord::settle_s},
     {"voltage_limited", &PointRecord::voltage_limited},
     {"unstable", &PointRecord::unstable},
@@ -67,6 +66,7 @@ inline const std::array<RecordColumn, 39> kRecordColumns{{
     {"below_min_speed", &PointRecord::below_min_speed},    // schema version 2
     {"fallback_fraction", &PointRecord::fallback_fraction},
     {"lock_lost", &PointRecord::lock_lost},                // schema version 3
+    {"window_source", &PointRecord::window_source},        // schema version 5
 }};
 
 }  // namespace synbench::db::detail
