@@ -6,7 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
+#include <stdexcept>
 #include <sstream>
 #include <thread>
 
@@ -40,6 +42,9 @@ twin:
   --time-scale X         X seconds of twin time per wall second, 0 < X <= 1000 (default 1);
                          run the bench with the same time_scale (docs/bench-config.md)
   --config FILE          twin config JSON (see docs/emulator-config.md)
+  --profiles DIR         serve DIR/synrm_drive.json, DIR/load_drive.json, DIR/vfc_meter.json
+                         where present instead of the default profiles (drives without window
+                         signals, a totalizer or power meter: docs/device-profile.md)
   --seed N               noise seed (default from config)
   --udc-V V              DC-bus source voltage, 100..800 V (default 425)
   --temp-C T             winding temperature at start (default 50)
@@ -100,12 +105,20 @@ void parse_endpoint(const std::string& text, std::string& host, std::uint16_t& p
   port = static_cast<std::uint16_t>(v);
 }
 
-std::vector<drivers::DeviceProfile> default_profiles() {
+// The profile of each kind: DIR/<kind>.json when --profiles DIR has one, else the default.
+std::vector<drivers::DeviceProfile> served_profiles(const std::optional<std::string>& dir) {
   std::vector<drivers::DeviceProfile> out;
   for (const drivers::DeviceKind k : drivers::kDeviceKinds) {
-    drivers::ProfileParseResult r = drivers::load_device_profile(drivers::default_profile_path(k));
-    if (!r.profile) throw std::runtime_error("default profile " + drivers::default_profile_path(k).string() +
-                                             " does not parse: " + r.errors.front().reason);
+    std::filesystem::path path = drivers::default_profile_path(k);
+    if (dir && std::filesystem::exists(std::filesystem::path(*dir) / path.filename()))
+      path = std::filesystem::path(*dir) / path.filename();
+    drivers::ProfileParseResult r = drivers::load_device_profile(path);
+    if (!r.profile)
+      throw std::runtime_error("profile " + path.string() + " does not parse: " + r.errors.front().path + ": " +
+                               r.errors.front().reason);
+    if (r.profile->kind != k)
+      throw std::runtime_error("profile " + path.string() + " is of kind " + std::string(drivers::name(r.profile->kind)) +
+                               ", not " + std::string(drivers::name(k)));
     out.push_back(std::move(*r.profile));
   }
   return out;
@@ -122,9 +135,10 @@ int emulate_command(const std::vector<std::string>& argv) {
   double time_scale = 1, cut_s = 2;
   std::optional<double> duration_s, watchdog_s;
   std::vector<std::pair<int, std::string>> stuck;
+  std::optional<std::string> profiles_dir;
   try {
     Args a(argv, {"--help"},
-           {"--tcp", "--rtu", "--baud", "--parity", "--time-scale", "--config", "--seed", "--udc-V", "--temp-C",
+           {"--tcp", "--rtu", "--baud", "--parity", "--time-scale", "--config", "--profiles", "--seed", "--udc-V", "--temp-C",
             "--duration-s", "--watchdog-timeout-ms", "--fault-delay-pct", "--fault-delay-ms", "--fault-drop-pct", "--fault-exception-pct",
             "--fault-corrupt-pct", "--fault-stuck", "--fault-cut-s", "--fault-seed"});
     if (a.has("--help")) {
@@ -159,6 +173,7 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (!(time_scale > 0) || time_scale > 1000)
       throw UsageError("--time-scale", fmt(time_scale) + " is outside (0, 1000]");
     if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
+    profiles_dir = a.text("--profiles");
     if (auto seed = a.number("--seed")) {
       if (*seed < 0 || *seed > 2147483647 || *seed != std::floor(*seed))
         throw UsageError("--seed", "must be a whole number in [0, 2147483647]");
@@ -220,7 +235,14 @@ int emulate_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
-  emulator::TwinService service(config, default_profiles());
+  std::vector<drivers::DeviceProfile> profiles;
+  try {
+    profiles = served_profiles(profiles_dir);
+  } catch (const std::runtime_error& e) {
+    std::cerr << "synbench emulate: --profiles: " << e.what() << "\n";
+    return 2;
+  }
+  emulator::TwinService service(config, std::move(profiles));
   for (const auto& [unit, signal] : stuck) {
     const auto ec = service.locked([&](auto&, auto&, emulator::RegisterServer& server) {
       return server.stick(static_cast<std::uint8_t>(unit), signal);

@@ -185,6 +185,17 @@ int sweep_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
+  // A plan the bench's profiles cannot serve is refused before anything is stored (a resumed
+  // plan is checked once read back, below).
+  if (plan && loaded) {
+    app::BenchDescription needs;
+    if (!loaded->profiles.synrm_drive.find("temp_C")) needs.synrm_without_temperature = loaded->profiles.synrm_drive.name;
+    if (auto unmet = app::unmet_plan_needs(*plan, needs)) {
+      std::cerr << "synbench sweep: refused before the start: " << *unmet << "\n";
+      return 2;
+    }
+  }
+
   // Checked before the bench moves: damaged pages and a file that cannot be written are refused.
   db::StoreOptions store_options;
   store_options.verify = true;
