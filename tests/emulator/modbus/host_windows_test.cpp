@@ -143,5 +143,30 @@ TEST(HostWindows, APointThroughHostWindowsAndAPowerMeterAgreesWithTheDeviceWindo
   expect_agree(power.record, device.record);
 }
 
+// A drive without temp_C has no winding temperature: the record says null, not 0 degC, and a
+// point asked to hold a thermal precondition fails naming the signal instead of warming blind
+// (the sweep refuses such a plan before its start: app/plan_needs.hpp).
+TEST(HostWindows, NoTemperatureIsNullAndAThermalPreconditionFailsNamingTempC) {
+  const Measured host = measure(host_windows("meter_totalizer.json"));
+  EXPECT_FALSE(host.record.temp_C);
+  auto profiles = host_windows("meter_totalizer.json");
+  TwinService service{TwinConfig{}, profiles};
+  TwinRegisterBus bus{service};
+  TwinServiceClock clock{service};
+  drivers::ProfileBench bench{bus, profiles[0], bus, profiles[1], bus, profiles[2], clock};
+  bench::PointRequest req;
+  req.speed_rpm = 600;
+  req.load_Nm = 1.5;
+  bench::PointOptions opt;
+  opt.thermal = bench::PointOptions::Thermal{};
+  const auto proc = bench::run_point(bench.devices(), bench.clock(), req, opt);
+  EXPECT_EQ(proc.phase(), bench::PointPhase::failed);
+  EXPECT_FALSE(proc.has_record());
+  EXPECT_NE(proc.error().find("temp_C"), std::string::npos) << proc.error();
+  drivers::LoadTelemetry lt;
+  ASSERT_FALSE(bench.load().read(lt));
+  EXPECT_LT(lt.torque_Nm, 0.1);  // stopped in order, not warmed at 3.5 N m
+}
+
 }  // namespace
 }  // namespace synbench::emulator
