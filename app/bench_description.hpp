@@ -4,6 +4,9 @@
 // "calibration" give it for real drives; for the in-process twin it follows the twin's config.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "bench/safety_supervisor.hpp"
 
 namespace synbench::app {
@@ -14,6 +17,9 @@ struct BenchDescription {
   double max_load_Nm = 10.0;
   double load_b1_Nms_per_rad = 2.0e-4;  // the load machine's viscous friction (shaft power)
   double poll_period_s = 0.01;          // telemetry reads of `synbench sweep` and `point`
+  // The SynRM drive's profile name when it maps no temp_C: no winding temperature to run a
+  // thermal precondition on (app/plan_needs.hpp).
+  std::optional<std::string> synrm_without_temperature;
 };
 
 }  // namespace synbench::app

@@ -2,6 +2,7 @@
 #include "app/bench_runtime.hpp"
 
 
+#include "app/plan_needs.hpp"
 #include "bench/load_ramp.hpp"
 #include "drivers/error.hpp"
 #include "drivers/number_text.hpp"
@@ -346,6 +347,7 @@ void BenchRuntime::start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<
         if (sweep_) return Refusal{Refused::sweep_running, "sweep " + std::to_string(sweep_->id()) + " is running"};
         if (enabled_ || stop_.active())
           return Refusal{Refused::bench_in_use, "the bench is enabled by hand; disable it first"};
+        if (auto unmet = unmet_plan_needs(shared->first, description_)) return Refusal{Refused::invalid_state, *unmet};
         auto opened = db::Store::open(db_path);
         if (!opened) return Refusal{Refused::database, opened.error().message};
         sweep_store_ = std::make_unique<db::Store>(std::move(*opened));

@@ -244,11 +244,18 @@ void PointProcedure::tick(double now_s) {
       }
       if (settled || timed_out) {
         if (timed_out && !settled) record_.unstable = true;
-        if (opt_.thermal && std::fabs(st.temp_C - opt_.thermal->target_C) > opt_.thermal->band_C) {
+        if (opt_.thermal && !st.temp_C) {
+          // Refused before a start where the profiles are known (app/plan_needs.hpp); a device
+          // that stopped reporting it is not warmed blind either.
+          error_ = "the thermal precondition needs the winding temperature, and the SynRM drive reports no temp_C";
+          begin_stop(now_s, /*ramped=*/true);
+          return;
+        }
+        if (opt_.thermal && std::fabs(*st.temp_C - opt_.thermal->target_C) > opt_.thermal->band_C) {
           if (t_thermal_ < 0) t_thermal_ = now_s;
           if (now_s - t_thermal_ <= opt_.thermal->timeout_s) {
             // Warm with load or cool unloaded, then come back and settle again.
-            const bool cold = st.temp_C < opt_.thermal->target_C;
+            const bool cold = *st.temp_C < opt_.thermal->target_C;
             command_load(cold ? opt_.thermal->warmup_load_Nm : 0.0);
             enter(PointPhase::thermal, now_s);
             return;
@@ -262,7 +269,7 @@ void PointProcedure::tick(double now_s) {
     case PointPhase::thermal: {
       // Inside the band with half a band of margin, so the window does not end outside it.
       const auto& th = *opt_.thermal;
-      const bool inside = std::fabs(st.temp_C - th.target_C) < 0.5 * th.band_C;
+      const bool inside = st.temp_C && std::fabs(*st.temp_C - th.target_C) < 0.5 * th.band_C;
       if (inside || now_s - t_thermal_ > th.timeout_s) {
         command_load(req_.load_Nm);
         enter(PointPhase::load_up, now_s);
@@ -321,10 +328,18 @@ std::error_code PointProcedure::read_results(const char*& what) {
   r.ud_V = w.ud_V;
   r.uq_V = w.uq_V;
   r.udc_V = w.udc_V;
-  r.idcm_A = m.idcm_A;
-  r.idcg_A = m.idcg_A;
-  r.pdcm_W = r.udc_V * m.idcm_A;
-  r.pdcg_W = r.udc_V * m.idcg_A;
+  if (m.pdcm_W && m.pdcg_W) {
+    // A power meter's own averages; the currents are what they imply at the window's U_dc.
+    r.pdcm_W = *m.pdcm_W;
+    r.pdcg_W = *m.pdcg_W;
+    r.idcm_A = r.udc_V > 0 ? r.pdcm_W / r.udc_V : 0.0;
+    r.idcg_A = r.udc_V > 0 ? r.pdcg_W / r.udc_V : 0.0;
+  } else {
+    r.idcm_A = m.idcm_A;
+    r.idcg_A = m.idcg_A;
+    r.pdcm_W = r.udc_V * m.idcm_A;
+    r.pdcg_W = r.udc_V * m.idcg_A;
+  }
   const double wm = w.speed_meas_rpm * 2.0 * kPi / 60.0;
   r.pm_W = lw.torque_Nm * wm + opt_.load_b1_Nms_per_rad * wm * wm;
   r.efficiency = r.pdcm_W > 0 ? r.pm_W / r.pdcm_W : 0.0;
@@ -344,6 +359,7 @@ std::error_code PointProcedure::read_results(const char*& what) {
   r.temp_C = w.temp_C;
   r.window_s = m.gate_s > 0 ? m.gate_s : w.window_s;
   r.samples = w.samples;
+  r.window_source = w.keeper;
   r.voltage_limited = w.voltage_limited_fraction > 0;
   r.fallback_fraction = w.fallback_fraction;
   r.below_min_speed = w.fallback_fraction > 0.5;

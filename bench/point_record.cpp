@@ -45,7 +45,7 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["ld_err_pct"] = opt(r.ld_err_pct);
   j["lq_err_pct"] = opt(r.lq_err_pct);
   j["rs_err_pct"] = opt(r.rs_err_pct);
-  j["temp_C"] = r.temp_C;
+  j["temp_C"] = opt(r.temp_C);
   j["window_s"] = r.window_s;
   j["samples"] = r.samples;
   j["settle_s"] = r.settle_s;
@@ -55,6 +55,7 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["below_min_speed"] = r.below_min_speed;
   j["fallback_fraction"] = r.fallback_fraction;
   j["lock_lost"] = r.lock_lost;
+  j["window_source"] = drivers::keeper_name(r.window_source);
   if (r.truth) {
     const auto& t = *r.truth;
     j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},

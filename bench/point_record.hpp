@@ -25,8 +25,12 @@ struct PointRecord {
   std::optional<double> pos_err_min_deg, pos_err_mean_deg, pos_err_max_deg, speed_err_rpm;
   std::optional<double> ld_est_H, lq_est_H, rs_est_ohm, ld_err_pct, lq_err_pct, rs_err_pct;
   // conditions
-  double temp_C = 0, window_s = 0, settle_s = 0;
+  std::optional<double> temp_C;  // empty when the SynRM drive reports no temperature
+  double window_s = 0, settle_s = 0;
+  // The SynRM drive's window's samples: its control periods (window_source device), or the
+  // telemetry polls the bench averaged (host).
   std::uint32_t samples = 0;
+  drivers::WindowKeeper window_source = drivers::WindowKeeper::device;
   // flags
   bool voltage_limited = false, unstable = false;
   std::optional<std::string> fault;

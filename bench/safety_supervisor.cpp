@@ -151,8 +151,8 @@ void SafetySupervisor::tick(double now_s) {
       raise(now_s, drivers::Fault::overvoltage, format("DC bus %.0f V > %.0f V", s.udc_V, lim_.max_udc_V));
     else if (drivers::running(s.state) && s.udc_V < lim_.min_udc_V)
       raise(now_s, drivers::Fault::undervoltage, format("DC bus %.0f V < %.0f V", s.udc_V, lim_.min_udc_V));
-    else if (s.temp_C > lim_.max_temp_C)
-      raise(now_s, drivers::Fault::overtemperature, format("winding %.1f degC > %.1f degC", s.temp_C, lim_.max_temp_C));
+    else if (s.temp_C && *s.temp_C > lim_.max_temp_C)
+      raise(now_s, drivers::Fault::overtemperature, format("winding %.1f degC > %.1f degC", *s.temp_C, lim_.max_temp_C));
   }
   if (load_ && !trip_ && load_->fault != drivers::Fault::none)
     raise(now_s, drivers::Fault::load_drive, "load drive reports " + std::string(drivers::fault_name(load_->fault)));

@@ -59,9 +59,10 @@ std::optional<Implausibility> TelemetryPlausibility::check(double now_s, const d
   if (std::isnan(t.udc_V) || t.udc_V < lim_.min_udc_V)
     return Implausibility{"udc_V", format("%.4g V is below %.3g V: the DC bus never reverses", t.udc_V,
                                           lim_.min_udc_V)};
-  if (std::isnan(t.temp_C) || t.temp_C < lim_.min_temp_C || t.temp_C > lim_.max_temp_C)
+  // No sensor mapped is no reading, not a broken one.
+  if (t.temp_C && (std::isnan(*t.temp_C) || *t.temp_C < lim_.min_temp_C || *t.temp_C > lim_.max_temp_C))
     return Implausibility{"temp_C", format("%.4g degC is outside [%.4g, %.4g] degC: a broken winding sensor",
-                                           t.temp_C, lim_.min_temp_C, lim_.max_temp_C)};
+                                           *t.temp_C, lim_.min_temp_C, lim_.max_temp_C)};
   if (std::isnan(t.speed_rpm))
     return Implausibility{"speed_rpm", "is not a number"};
 

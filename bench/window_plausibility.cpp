@@ -31,13 +31,15 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
       {"window_im_A", w.im_A},          {"window_id_A", w.id_A},
       {"window_iq_A", w.iq_A},          {"window_ud_V", w.ud_V},
       {"window_uq_V", w.uq_V},          {"window_udc_V", w.udc_V},
-      {"window_temp_C", w.temp_C},      {"window_voltage_limited_fraction", w.voltage_limited_fraction},
+      {"window_voltage_limited_fraction", w.voltage_limited_fraction},
       {"window_fallback_fraction", w.fallback_fraction}, {"window_lock_lost_fraction", w.lock_lost_fraction},
       {"window_torque_Nm", load.torque_Nm}, {"gate_s", meter.gate_s},
       {"idcm_A", meter.idcm_A},         {"idcg_A", meter.idcg_A},
   };
   for (const auto& f : finite)
     if (!std::isfinite(f.value)) return say(f.field, "%g is not a finite number", f.value);
+  for (const auto& [field, value] : {std::pair{"pdcm_W", meter.pdcm_W}, std::pair{"pdcg_W", meter.pdcg_W}})
+    if (value && !std::isfinite(*value)) return say(field, "%g is not a finite number", *value);
   const struct {
     const char* field;
     const std::optional<double>& value;
@@ -45,7 +47,7 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
       {"window_pos_err_min_deg", w.pos_err_min_deg}, {"window_pos_err_mean_deg", w.pos_err_mean_deg},
       {"window_pos_err_max_deg", w.pos_err_max_deg}, {"window_speed_err_rpm", w.speed_err_rpm},
       {"window_ld_est_H", w.ld_est_H},               {"window_lq_est_H", w.lq_est_H},
-      {"window_rs_est_ohm", w.rs_est_ohm},
+      {"window_rs_est_ohm", w.rs_est_ohm},           {"window_temp_C", w.temp_C},
   };
   for (const auto& e : estimates)
     if (e.value && !std::isfinite(*e.value)) return say(e.field, "%g is not a finite number", *e.value);
@@ -61,8 +63,8 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
     return say("window_im_A", "%g A is less than the magnitude of the window's mean (I_d, I_q), %g A", w.im_A,
                std::hypot(w.id_A, w.iq_A));
   if (w.udc_V < kMinUdc_V) return say("window_udc_V", "%g V is negative: the DC bus never reverses", w.udc_V);
-  if (w.temp_C < kMinTemp_C || w.temp_C > kMaxTemp_C)
-    return say("window_temp_C", "%g degC is outside a winding's [-30, 250] degC", w.temp_C);
+  if (w.temp_C && (*w.temp_C < kMinTemp_C || *w.temp_C > kMaxTemp_C))
+    return say("window_temp_C", "%g degC is outside a winding's [-30, 250] degC", *w.temp_C);
   const struct {
     const char* field;
     double value;

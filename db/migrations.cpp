@@ -113,11 +113,18 @@ ALTER TABLE sweeps ADD COLUMN owner_pid INTEGER;
 ALTER TABLE sweeps ADD COLUMN owner_start TEXT;
 )sql";
 
+// Version 5: who kept the point's window: the device, or the bench from polled telemetry (a
+// drive profile without window signals). Rows from before were all device-kept.
+constexpr std::string_view kSchemaV5 = R"sql(
+ALTER TABLE points ADD COLUMN window_source TEXT NOT NULL DEFAULT 'device' CHECK (window_source IN ('device', 'host'));
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
     Migration{3, "points: lock_lost", kSchemaV3},
     Migration{4, "sweeps: owner_host, owner_pid, owner_start", kSchemaV4},
+    Migration{5, "points: window_source", kSchemaV5},
 };
 
 struct Header {

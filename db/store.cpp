@@ -102,6 +102,9 @@ void bind_record(Statement& st, int first, const bench::PointRecord& r) {
                    [&](std::uint32_t bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m}); },
                    [&](bool bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m ? 1 : 0}); },
                    [&](std::optional<std::string> bench::PointRecord::*m) { st.bind(i, r.*m); },
+                   [&](drivers::WindowKeeper bench::PointRecord::*m) {
+                     st.bind(i, std::string_view(drivers::keeper_name(r.*m)));
+                   },
                },
                c.member);
     ++i;
@@ -146,6 +149,13 @@ Status read_record(const Statement& st, int first, bench::PointRecord& r) {
             },
             [&](std::optional<std::string> bench::PointRecord::*m) -> Status {
               r.*m = st.opt_text(i);
+              return {};
+            },
+            [&](drivers::WindowKeeper bench::PointRecord::*m) -> Status {
+              const std::string v = st.text(i);
+              if (v != "device" && v != "host")
+                return make_error(errc::bad_record, "unknown window_source \"" + v + "\"");
+              r.*m = v == "host" ? drivers::WindowKeeper::host : drivers::WindowKeeper::device;
               return {};
             },
         },

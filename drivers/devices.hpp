@@ -39,7 +39,7 @@ struct SynrmTelemetry {
   double uq_V = 0;
   double udc_V = 0;
   double pac_W = 0;  // 1.5 (ud id + uq iq): the drive's own estimate of its output power
-  double temp_C = 0;
+  std::optional<double> temp_C;  // empty when the drive's profile maps no temp_C
   bool voltage_limited = false;
   // Estimated minus encoder electrical angle, wrapped to (-90, 90] deg, at the last control
   // period; empty when the encoder is the position source, and while the lock guard holds.
@@ -52,12 +52,20 @@ struct SynrmTelemetry {
   Fault fault = Fault::none;
 };
 
-// Results of one measurement window, accumulated by the drive at its control rate.
+// Who kept a measurement window: the device (its window registers; samples are its control
+// periods) or the bench (telemetry polled every poll_period_ms; samples are the polls).
+enum class WindowKeeper { device, host };
+
+constexpr const char* keeper_name(WindowKeeper k) { return k == WindowKeeper::host ? "host" : "device"; }
+
+// Results of one measurement window, accumulated by the drive at its control rate (or by the
+// bench from polled telemetry: keeper host).
 struct SynrmWindow {
   std::uint32_t samples = 0;
   double window_s = 0;
   double speed_meas_rpm = 0;  // from encoder counts over the window
-  double im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0, udc_V = 0, temp_C = 0;
+  double im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0, udc_V = 0;
+  std::optional<double> temp_C;  // empty when the drive reports no temperature
   double voltage_limited_fraction = 0;
   // Fraction of the samples in which a low-speed fallback gave the angle instead of the selected
   // estimator (an EEMF observer below its minimum speed hands over to HFI or the encoder).
@@ -71,6 +79,7 @@ struct SynrmWindow {
   // from the drive's flux maps, Rs at the winding temperature); empty for the encoder.
   std::optional<double> ld_ref_H, lq_ref_H, rs_ref_ohm;
   Fault fault = Fault::none;  // fault latched during the window, if any
+  WindowKeeper keeper = WindowKeeper::device;
 };
 
 class SynrmDrive {
@@ -97,6 +106,7 @@ struct LoadTelemetry {
 struct LoadWindow {
   std::uint32_t samples = 0;
   double torque_Nm = 0;
+  WindowKeeper keeper = WindowKeeper::device;
 };
 
 class LoadDrive {
@@ -110,13 +120,19 @@ class LoadDrive {
   virtual std::error_code read_window(LoadWindow& out) = 0;
 };
 
-// VFC counts of the two DC-bus currents over the gate, and the currents the meter derives.
+// VFC counts of the two DC-bus currents over the gate, and the currents the meter derives; or
+// (a power meter) the instrument's average DC powers over the window, sampled by the bench.
 struct MeterReading {
   std::uint64_t counts_m = 0;
   std::uint64_t counts_g = 0;
   double gate_s = 0;
   double idcm_A = 0;
   double idcg_A = 0;
+  // Set by a power meter: the bench then takes these instead of udc_V x idc (idcm_A and idcg_A
+  // stay 0: the meter does not measure them).
+  std::optional<double> pdcm_W, pdcg_W;
+  WindowKeeper keeper = WindowKeeper::device;
+  std::uint32_t samples = 0;  // host-kept: the polls averaged
 };
 
 class PowerMeter {

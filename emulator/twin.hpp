@@ -67,6 +67,7 @@ class Twin {
   void open_window(double window_s);
   bool window_open() const { return window_pending_ > 0 || window_left_ > 0; }
   const drivers::MeterReading& meter_reading() const { return vfc_.reading(); }
+  const VfcMeter& vfc() const { return vfc_; }
   std::optional<drivers::TruthWindow> truth_window() const { return truth_; }
 
   PlantSnapshot snapshot() const;

@@ -34,6 +34,9 @@ class VfcMeter {
     reading_.idcg_A = current(reading_.counts_g, reading_.gate_s);
   }
   const drivers::MeterReading& reading() const { return reading_; }
+  // Whole pulses since power-on: what a free-running counter of each channel holds.
+  double pulses_m() const { return std::floor(phase_m_); }
+  double pulses_g() const { return std::floor(phase_g_); }
 
   double current(std::uint64_t counts, double gate_s) const {
     return (static_cast<double>(counts) / gate_s - p_.f0_Hz) / p_.kf_Hz_per_A;

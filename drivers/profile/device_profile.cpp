@@ -13,6 +13,7 @@
 
 #include "drivers/json_file.hpp"
 #include "drivers/profile/number_format.hpp"
+#include "drivers/profile/window_schema.hpp"
 
 #ifndef SYNBENCH_PROFILE_DIR
 #error "SYNBENCH_PROFILE_DIR must name drivers/profiles (set by drivers/CMakeLists.txt)"
@@ -396,7 +397,8 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
     p.fail("", "a profile must be a JSON object");
     return {std::nullopt, std::move(p.errors)};
   }
-  p.reject_unknown(doc, "", {"name", "description", "kind", "unit_id", "word_order", "byte_order", "signals"});
+  p.reject_unknown(doc, "", {"name", "description", "kind", "unit_id", "word_order", "byte_order", "signals",
+                             "meter", "poll_period_ms", "time_base_Hz", "f0_Hz", "kf_Hz_per_A"});
 
   DeviceProfile profile;
   profile.name = p.string_field(doc, "", "name", true).value_or("");
@@ -435,6 +437,7 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
       if (spec.required && !signals->contains(spec.name))
         p.fail("/signals/" + json_pointer_token(spec.name),
                "required signal of kind " + std::string(name(*kind)) + " is missing");
+    parse_window_schema(doc, profile, p.errors);
   }
 
   if (!p.errors.empty()) return {std::nullopt, std::move(p.errors)};

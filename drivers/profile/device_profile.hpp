@@ -63,12 +63,24 @@ struct ProfileSignal {
   }
 };
 
+// What a vfc_meter profile measures a window with (top-level "meter"): synbench's gated VFC
+// counter, free-running counters read at window open and close, or an instrument's own
+// average power.
+enum class MeterKind { gate, totalizer, power };
+
 struct DeviceProfile {
   std::string name;
   std::string description;
   DeviceKind kind = DeviceKind::synrm_drive;
   std::uint8_t unit_id = 1;
   std::vector<ProfileSignal> signals;  // ordered by register kind, unit id, address
+  // Window and meter (drivers/profile/window_schema.hpp). A drive without window signals, and
+  // a power meter, are sampled by the bench every poll_period_ms; a totalizer's gate is
+  // d(time_base_ticks) / time_base_Hz and its currents come from f0_Hz and kf_Hz_per_A.
+  MeterKind meter = MeterKind::gate;
+  std::optional<std::uint32_t> poll_period_ms;
+  double time_base_Hz = 0;
+  double f0_Hz = 0, kf_Hz_per_A = 0;
 
   const ProfileSignal* find(std::string_view signal) const;
 };

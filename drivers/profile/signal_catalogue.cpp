@@ -1,6 +1,7 @@
 // The signal catalogue. Required are the signals without which the bench cannot command a
-// device, keep it safe, or run a measurement window on it; everything else is optional, and a
-// driver answers errc::not_supported for an optional signal its profile leaves out.
+// device or keep it safe; everything else is optional, and a driver answers errc::not_supported
+// for an optional signal its profile leaves out. The window and meter signals are required as
+// groups, by the profile's choice of window and meter (drivers/profile/window_schema.cpp).
 #include "drivers/profile/signal_catalogue.hpp"
 
 #include "drivers/fault.hpp"
@@ -31,8 +32,8 @@ constexpr SignalSpec kSynrm[] = {
     {"heartbeat", R::heartbeat, true, "",
      "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
      "has not changed for timeout_ms"},
-    {"window_start", R::window_start, true, "", "writing 1 opens a window of window_length_ms"},
-    {"window_length_ms", R::window_length, true, "ms", "length of the next window"},
+    {"window_start", R::window_start, false, "", "writing 1 opens a window of window_length_ms"},
+    {"window_length_ms", R::window_length, false, "ms", "length of the next window"},
     {"state", R::telemetry, true, "", "drive state", kStateLabels},
     {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp)", kFaultLabels},
     {"speed_rpm", R::telemetry, true, "rpm", "filtered speed"},
@@ -47,10 +48,10 @@ constexpr SignalSpec kSynrm[] = {
     {"voltage_limited", R::telemetry, false, "", "1 while the voltage limit is active"},
     {"pos_err_deg", R::telemetry, false, "deg", "estimated minus encoder angle, last control period; not with the encoder"},
     {"lock_lost", R::telemetry, false, "", "1 while the lock guard runs a sensorless drive on the encoder (until a changed speed or angle setpoint is reached)"},
-    {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
-    {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
-    {"window_samples", R::window_result, true, "", "control periods accumulated"},
-    {"window_s", R::window_result, true, "s", "accumulated duration"},
+    {"window_status", R::window_status, false, "", "window state", kWindowStatusLabels},
+    {"window_sequence", R::window_sequence, false, "", "increments (mod 65536) per closed window"},
+    {"window_samples", R::window_result, false, "", "control periods accumulated"},
+    {"window_s", R::window_result, false, "s", "accumulated duration"},
     {"window_fault_code", R::window_result, false, "", "fault latched during the window", kFaultLabels},
     {"window_speed_meas_rpm", R::window_result, false, "rpm", "speed from encoder counts over the window"},
     {"window_im_A", R::window_result, false, "A", "mean"},
@@ -88,24 +89,32 @@ constexpr SignalSpec kLoad[] = {
     {"fault_code", R::telemetry, true, "", "latched fault (drivers/fault.hpp)", kFaultLabels},
     {"torque_Nm", R::telemetry, true, "Nm", "braking torque magnitude from the measured current"},
     {"iq_A", R::telemetry, false, "A", "q current"},
-    {"window_status", R::window_status, true, "", "window state", kWindowStatusLabels},
-    {"window_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed window"},
-    {"window_samples", R::window_result, true, "", "control periods accumulated"},
-    {"window_torque_Nm", R::window_result, true, "Nm", "mean braking torque"},
+    {"window_status", R::window_status, false, "", "window state", kWindowStatusLabels},
+    {"window_sequence", R::window_sequence, false, "", "increments (mod 65536) per closed window"},
+    {"window_samples", R::window_result, false, "", "control periods accumulated"},
+    {"window_torque_Nm", R::window_result, false, "Nm", "mean braking torque"},
 };
 
 constexpr SignalSpec kMeter[] = {
-    {"gate_start", R::window_start, true, "", "writing 1 opens a gate of gate_length_ms"},
-    {"gate_length_ms", R::window_length, true, "ms", "length of the next gate"},
-    {"gate_status", R::window_status, true, "", "gate state", kWindowStatusLabels},
-    {"gate_sequence", R::window_sequence, true, "", "increments (mod 65536) per closed gate"},
-    {"counts_m", R::window_result, true, "", "VFC pulses of the motor-side DC current over the gate"},
-    {"counts_g", R::window_result, true, "", "VFC pulses of the generator-side DC current over the gate"},
-    {"gate_s", R::window_result, true, "s", "measured gate duration"},
-    {"idcm_A", R::window_result, true, "A", "motor-side DC current, (counts_m / gate_s - f0_Hz) / kf_Hz_per_A"},
-    {"idcg_A", R::window_result, true, "A", "generator-side DC current, (counts_g / gate_s - f0_Hz) / kf_Hz_per_A"},
+    {"gate_start", R::window_start, false, "", "writing 1 opens a gate of gate_length_ms"},
+    {"gate_length_ms", R::window_length, false, "ms", "length of the next gate"},
+    {"gate_status", R::window_status, false, "", "gate state", kWindowStatusLabels},
+    {"gate_sequence", R::window_sequence, false, "", "increments (mod 65536) per closed gate"},
+    {"counts_m", R::window_result, false, "", "VFC pulses of the motor-side DC current over the gate"},
+    {"counts_g", R::window_result, false, "", "VFC pulses of the generator-side DC current over the gate"},
+    {"gate_s", R::window_result, false, "s", "measured gate duration"},
+    {"idcm_A", R::window_result, false, "A", "motor-side DC current, (counts_m / gate_s - f0_Hz) / kf_Hz_per_A"},
+    {"idcg_A", R::window_result, false, "A", "generator-side DC current, (counts_g / gate_s - f0_Hz) / kf_Hz_per_A"},
     {"f0_Hz", R::calibration, false, "Hz", "nominal converter frequency at zero current"},
     {"kf_Hz_per_A", R::calibration, false, "Hz/A", "nominal converter gain"},
+    {"total_m", R::telemetry, false, "",
+     "free-running count of the motor-side VFC pulses (meter totalizer; u16 or u32, wraps at its range)"},
+    {"total_g", R::telemetry, false, "",
+     "free-running count of the generator-side VFC pulses (meter totalizer; u16 or u32, wraps at its range)"},
+    {"time_base_ticks", R::telemetry, false, "",
+     "free-running count of the meter's clock of time_base_Hz (meter totalizer; u16 or u32, wraps at its range)"},
+    {"pdcm_W", R::telemetry, false, "W", "motor-side DC power, the instrument's average (meter power)"},
+    {"pdcg_W", R::telemetry, false, "W", "generator-side DC power, the instrument's average (meter power)"},
 };
 
 constexpr std::array<std::string_view, 3> kKindNames{"synrm_drive", "load_drive", "vfc_meter"};

@@ -17,8 +17,8 @@ class ProfileBench::HeartbeatClock final : public Clock {
       // Within a microsecond counts as reached: a virtual clock moves in whole periods and
       // stops as close to t_s as they allow.
       if (now >= t_s - 1e-6) return;
-      // Wake for the next heartbeat, never for less than a microsecond of progress.
-      base_.wait_until(std::min(t_s, std::max(bench_.next_heartbeat_s(), now + 1e-6)));
+      // Wake for the next heartbeat or host sample, never for less than a microsecond of progress.
+      base_.wait_until(std::min(t_s, std::max(bench_.next_due_s(), now + 1e-6)));
     }
   }
 
@@ -33,7 +33,8 @@ ProfileBench::ProfileBench(RegisterBus& synrm_bus, DeviceProfile synrm, Register
     : synrm_(synrm_bus, std::move(synrm)),
       load_(load_bus, std::move(load)),
       meter_(meter_bus, std::move(meter)),
-      trigger_({&synrm_.window(), &load_.window(), &meter_.window()}, clock, options.window_margin_s),
+      trigger_({&synrm_.window_source(), &load_.window_source(), &meter_.window_source()}, clock,
+               options.window_margin_s),
       clock_(std::make_unique<HeartbeatClock>(*this, clock)) {
   for (ProfileDevice* d : {static_cast<ProfileDevice*>(&synrm_), static_cast<ProfileDevice*>(&load_),
                            static_cast<ProfileDevice*>(&meter_)})
@@ -47,11 +48,15 @@ BenchDevices ProfileBench::devices() { return {&synrm_, &load_, &meter_, &trigge
 Clock& ProfileBench::clock() { return *clock_; }
 
 void ProfileBench::tick(double now_s) {
+  // Host windows sample on their grid whether or not the heartbeats run.
+  trigger_.tick(now_s);
   if (!heartbeats_) return;
   synrm_.tick(now_s);
   load_.tick(now_s);
   meter_.tick(now_s);
 }
+
+double ProfileBench::next_due_s() const { return std::min(next_heartbeat_s(), trigger_.next_due_s()); }
 
 double ProfileBench::next_heartbeat_s() const {
   if (!heartbeats_) return std::numeric_limits<double>::infinity();

@@ -1,7 +1,8 @@
 // The bench's devices from three profiles and the buses that reach them: what `synbench point
 // --bench` measures with, on hardware, on `synbench emulate` or on the in-process twin's
-// register server. Its clock is the given one plus the watchdog heartbeats: whenever the bench
-// waits, the heartbeats due meanwhile are sent, so logic never has to remember them.
+// register server. Its clock is the given one plus the watchdog heartbeats and the host-kept
+// windows' samples: whenever the bench waits, the heartbeats and samples due meanwhile are
+// taken, so logic never has to remember them.
 #pragma once
 
 #include <memory>
@@ -32,9 +33,12 @@ class ProfileBench {
   BenchDevices devices();
   // The given clock; waiting on it keeps the heartbeats going.
   Clock& clock();
-  // Sends the heartbeats due at `now_s` (none while they are stopped).
+  // Takes the host-window samples due at `now_s`, and sends the heartbeats due (none while they
+  // are stopped).
   void tick(double now_s);
   double next_heartbeat_s() const;
+  // The next heartbeat or host sample.
+  double next_due_s() const;
   // Stops or resumes the heartbeats: stopped, the drives' watchdogs stop the drives on their own.
   void set_heartbeats(bool on) { heartbeats_ = on; }
   bool heartbeats() const { return heartbeats_; }

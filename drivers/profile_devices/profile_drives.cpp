@@ -30,6 +30,14 @@ void require_kind(const DeviceProfile& p, DeviceKind kind) {
 ProfileDevice::ProfileDevice(RegisterBus& bus, DeviceProfile profile)
     : profile_(std::move(profile)), io_(bus, profile_), heartbeat_(heartbeat_of(profile_)), window_(io_) {}
 
+HostWindow* ProfileDevice::host_window_over(const ReadPlan& plan) {
+  if (!profile_.poll_period_ms) return nullptr;
+  auto w = std::make_unique<HostWindow>(io_, plan, *profile_.poll_period_ms / 1000.0);
+  HostWindow* raw = w.get();
+  set_window_source(std::move(w));
+  return raw;
+}
+
 // --- SynRM drive ---------------------------------------------------------------------------
 
 ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
@@ -44,7 +52,8 @@ ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
       estimator_window_(this->profile(),
                         {"window_pos_err_min_deg", "window_pos_err_mean_deg", "window_pos_err_max_deg",
                          "window_speed_err_rpm", "window_ld_est_H", "window_lq_est_H",
-                         "window_rs_est_ohm", "window_estimates_present"}) {}
+                         "window_rs_est_ohm", "window_estimates_present"}),
+      host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileSynrmDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
 std::error_code ProfileSynrmDrive::set_speed_rpm(double v) { return io().write("speed_setpoint_rpm", v); }
@@ -81,7 +90,7 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   out.uq_V = or_(v[7]);
   out.udc_V = or_(v[8]);
   out.pac_W = or_(v[9]);
-  out.temp_C = or_(v[10]);
+  out.temp_C = opt(v[10]);
   out.voltage_limited = or_(v[11]) != 0;
   // The register reads 0 with the encoder and on the lock guard; a profile without it leaves the
   // field empty.
@@ -91,6 +100,7 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
 }
 
 std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
+  if (host_) return read_host_window(out);
   double v[16];
   if (auto ec = window().read_results(window_, v)) return ec;
   SynrmWindow w;
@@ -104,7 +114,7 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   w.ud_V = or_(v[9]);
   w.uq_V = or_(v[10]);
   w.udc_V = or_(v[11]);
-  w.temp_C = or_(v[12]);
+  w.temp_C = opt(v[12]);
   w.voltage_limited_fraction = or_(v[13]);
   w.fallback_fraction = or_(v[14]);
   w.lock_lost_fraction = or_(v[15]);
@@ -128,12 +138,43 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   return {};
 }
 
+// The window the bench kept from the telemetry plan's samples (indices as in read()). The
+// filtered telemetry is all there is: no encoder-count speed (the mean of speed_rpm stands in),
+// no Ld/Lq/Rs estimates, position errors only when the drive reports pos_err_deg live.
+std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
+  if (auto ec = host_->result()) return ec;
+  const HostWindow& h = *host_;
+  SynrmWindow w;
+  w.keeper = WindowKeeper::host;
+  w.samples = h.samples();
+  w.window_s = h.span_s();
+  w.fault = static_cast<Fault>(static_cast<int>(h.first_nonzero(1)));
+  w.speed_meas_rpm = h.mean(2);
+  w.im_A = or_(h.mean(3));
+  w.id_A = or_(h.mean(4));
+  w.iq_A = or_(h.mean(5));
+  w.ud_V = or_(h.mean(6));
+  w.uq_V = or_(h.mean(7));
+  w.udc_V = or_(h.mean(8));
+  w.temp_C = opt(h.mean(10));
+  w.voltage_limited_fraction = or_(h.mean(11));
+  w.lock_lost_fraction = or_(h.mean(13));
+  if (estimator_ != Estimator::encoder && telemetry_.present(12)) {
+    w.pos_err_min_deg = h.min(12);
+    w.pos_err_mean_deg = h.mean(12);
+    w.pos_err_max_deg = h.max(12);
+  }
+  out = w;
+  return {};
+}
+
 // --- Load drive ----------------------------------------------------------------------------
 
 ProfileLoadDrive::ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::load_drive), std::move(profile))),
       telemetry_(this->profile(), {"state", "fault_code", "torque_Nm", "iq_A"}),
-      window_(this->profile(), {"window_status", "window_sequence", "window_samples", "window_torque_Nm"}) {}
+      window_(this->profile(), {"window_status", "window_sequence", "window_samples", "window_torque_Nm"}),
+      host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileLoadDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
 std::error_code ProfileLoadDrive::set_torque_Nm(double v) { return io().write("torque_setpoint_Nm", v); }
@@ -150,6 +191,15 @@ std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
 }
 
 std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
+  if (host_) {
+    if (auto ec = host_->result()) return ec;
+    LoadWindow w;
+    w.keeper = WindowKeeper::host;
+    w.samples = host_->samples();
+    w.torque_Nm = host_->mean(2);
+    out = w;
+    return {};
+  }
   double v[4];
   if (auto ec = window().read_results(window_, v)) return ec;
   out.samples = static_cast<std::uint32_t>(or_(v[2]));
@@ -161,9 +211,33 @@ std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
 
 ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::vfc_meter), std::move(profile))),
-      gate_(this->profile(), {"gate_status", "gate_sequence", "counts_m", "counts_g", "gate_s", "idcm_A", "idcg_A"}) {}
+      gate_(this->profile(), {"gate_status", "gate_sequence", "counts_m", "counts_g", "gate_s", "idcm_A", "idcg_A"}),
+      power_(this->profile(), {"pdcm_W", "pdcg_W"}) {
+  switch (this->profile().meter) {
+    case MeterKind::gate: break;
+    case MeterKind::totalizer: {
+      auto t = std::make_unique<TotalizerWindow>(io());
+      totalizer_ = t.get();
+      set_window_source(std::move(t));
+      break;
+    }
+    case MeterKind::power: host_ = host_window_over(power_); break;
+  }
+}
 
 std::error_code ProfileMeter::read(MeterReading& out) {
+  if (totalizer_) return totalizer_->read(out);
+  if (host_) {
+    if (auto ec = host_->result()) return ec;
+    MeterReading m;
+    m.keeper = WindowKeeper::host;
+    m.samples = host_->samples();
+    m.gate_s = host_->span_s();
+    m.pdcm_W = host_->mean(0);
+    m.pdcg_W = host_->mean(1);
+    out = m;
+    return {};
+  }
   double v[7];
   if (auto ec = window().read_results(gate_, v)) return ec;
   out.counts_m = static_cast<std::uint64_t>(or_(v[2]));

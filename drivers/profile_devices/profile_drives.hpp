@@ -5,11 +5,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <system_error>
 
 #include "drivers/devices.hpp"
 #include "drivers/profile_devices/heartbeat.hpp"
+#include "drivers/profile_devices/host_window.hpp"
 #include "drivers/profile_devices/signal_io.hpp"
+#include "drivers/profile_devices/totalizer_window.hpp"
 #include "drivers/profile_devices/window_channel.hpp"
 
 namespace synbench::drivers {
@@ -25,6 +28,8 @@ class ProfileDevice {
   const DeviceProfile& profile() const { return profile_; }
   SignalIo& io() { return io_; }
   WindowChannel& window() { return window_; }
+  // What the trigger opens: the device's window channel, or the one set_window_source() gave.
+  WindowSource& window_source() { return source_ ? *source_ : static_cast<WindowSource&>(window_); }
   // Sends the heartbeat when due; errors are counted, the next tick retries.
   std::error_code tick(double now_s) { return heartbeat_.tick(now_s, io_); }
   double next_heartbeat_s() const { return heartbeat_.next_due_s(); }
@@ -33,12 +38,18 @@ class ProfileDevice {
  protected:
   // Writes 1 to the fault-reset signal.
   std::error_code pulse_fault_reset() { return io_.write("fault_reset", 1); }
+  // A window kept other than by the device's window signals (host_window.hpp,
+  // totalizer_window.hpp); the device's own constructor decides from its profile.
+  void set_window_source(std::unique_ptr<WindowSource> source) { source_ = std::move(source); }
+  // A host window over `plan` when the profile has poll_period_ms, else null.
+  HostWindow* host_window_over(const ReadPlan& plan);
 
  private:
   DeviceProfile profile_;
   SignalIo io_;
   Heartbeat heartbeat_;
   WindowChannel window_;
+  std::unique_ptr<WindowSource> source_;
 };
 
 class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
@@ -58,8 +69,11 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   std::error_code read_window(SynrmWindow& out) override;
 
  private:
+  std::error_code read_host_window(SynrmWindow& out);
+
   ReadPlan telemetry_, window_, estimator_window_;
   Estimator estimator_ = Estimator::encoder;  // estimator results are read only with another
+  HostWindow* host_ = nullptr;  // a profile without window signals: the bench keeps the window
 };
 
 class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
@@ -74,16 +88,22 @@ class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
 
  private:
   ReadPlan telemetry_, window_;
+  HostWindow* host_ = nullptr;
 };
 
 class ProfileMeter final : public PowerMeter, public ProfileDevice {
  public:
   ProfileMeter(RegisterBus& bus, DeviceProfile profile);
-  // The gate of the last window; errc::not_ready while it is open.
+  // The gate of the last window; errc::not_ready while it is open. By the profile's meter: the
+  // device's gate, the counter differences of a totalizer, or a power meter's sampled average.
   std::error_code read(MeterReading& out) override;
+  // The totalizer's window (meter totalizer), else null.
+  const TotalizerWindow* totalizer() const { return totalizer_; }
 
  private:
-  ReadPlan gate_;
+  ReadPlan gate_, power_;
+  TotalizerWindow* totalizer_ = nullptr;
+  HostWindow* host_ = nullptr;  // meter power
 };
 
 }  // namespace synbench::drivers

@@ -9,10 +9,11 @@
 #include <system_error>
 
 #include "drivers/profile_devices/signal_io.hpp"
+#include "drivers/profile_devices/window_source.hpp"
 
 namespace synbench::drivers {
 
-class WindowChannel {
+class WindowChannel final : public WindowSource {
  public:
   // The profile's signals of roles window_status, window_sequence, window_length, window_start.
   explicit WindowChannel(SignalIo& io);
@@ -24,7 +25,7 @@ class WindowChannel {
   const ProfileSignal* sequence_signal() const { return sequence_; }
 
   // Reads the sequence the next window must move on from; errc::busy while one is open.
-  std::error_code arm();
+  std::error_code arm() override;
   std::error_code write_length_ms(double length_ms);
   // Writes the start once. When the write fails in a way that leaves open whether the device
   // executed it (no reply, a garbled reply, a transient exception), the device is asked: a
@@ -38,9 +39,18 @@ class WindowChannel {
   // Reads status and sequence (no I/O once done); `done` when the armed window has closed.
   std::error_code poll(bool& done);
   // The window did not close in time: its results are reported as errc::timeout.
-  void expire() {
+  void expire() override {
     if (state_ == State::armed) state_ = State::expired;
   }
+
+  // As a WindowSource: a device without start and length (a trigger line opens its window)
+  // only arms and polls.
+  WindowKeeper keeper() const override { return WindowKeeper::device; }
+  std::error_code set_length_ms(double length_ms) override {
+    return startable() ? write_length_ms(length_ms) : std::error_code{};
+  }
+  std::error_code open(double, double) override { return startable() ? start() : std::error_code{}; }
+  std::error_code poll(double, bool& done) override { return poll(done); }
 
   // Reads `plan`, whose first two signals must be the status and the sequence, and checks it
   // is the armed window's result. errc::not_ready before it closed or when no window was

@@ -435,7 +435,7 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
     const double id_true = std::fabs(w_id_enc_.mean()), iq_true = std::fabs(w_iq_enc_.mean());
     r.ld_ref_H = flux_d_.dynamic_inductance_H(id_true);
     r.lq_ref_H = flux_q_.dynamic_inductance_H(iq_true);
-    r.rs_ref_ohm = rs_nominal_ohm_ * (1.0 + cfg_.synrm.rs_temp_coeff_per_K * (r.temp_C - cfg_.synrm.rs_ref_temp_C));
+    r.rs_ref_ohm = rs_nominal_ohm_ * (1.0 + cfg_.synrm.rs_temp_coeff_per_K * (*r.temp_C - cfg_.synrm.rs_ref_temp_C));
   }
   window_result_ = r;
 }

@@ -24,7 +24,10 @@ double or0(const std::optional<double>& v) { return v.value_or(0.0); }
 }  // namespace
 
 TwinSignals::TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& profiles)
-    : twin_(twin), f0_Hz_(twin.config().vfc.f0_Hz), kf_Hz_per_A_(twin.config().vfc.kf_Hz_per_A) {
+    : twin_(twin),
+      f0_Hz_(twin.config().vfc.f0_Hz),
+      kf_Hz_per_A_(twin.config().vfc.kf_Hz_per_A),
+      instruments_(twin, profiles) {
   for (const drivers::DeviceProfile& p : profiles)
     for (const drivers::ProfileSignal& s : p.signals)
       if (s.heartbeat) dev_[index(p.kind)].timeout_s = s.heartbeat->timeout_ms / 1000.0;
@@ -61,7 +64,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
     if (n == "window_ud_V") return w.ud_V;
     if (n == "window_uq_V") return w.uq_V;
     if (n == "window_udc_V") return w.udc_V;
-    if (n == "window_temp_C") return w.temp_C;
+    if (n == "window_temp_C") return or0(w.temp_C);
     if (n == "window_voltage_limited_fraction") return w.voltage_limited_fraction;
     if (n == "window_pos_err_min_deg") return or0(w.pos_err_min_deg);
     if (n == "window_pos_err_mean_deg") return or0(w.pos_err_mean_deg);
@@ -87,7 +90,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
   if (n == "uq_V") return t.uq_V;
   if (n == "udc_V") return t.udc_V;
   if (n == "pac_W") return t.pac_W;
-  if (n == "temp_C") return t.temp_C;
+  if (n == "temp_C") return or0(t.temp_C);
   if (n == "voltage_limited") return t.voltage_limited ? 1 : 0;
   if (n == "pos_err_deg") return or0(t.pos_err_deg);
   if (n == "lock_lost") return t.lock_lost ? 1 : 0;
@@ -132,7 +135,9 @@ double TwinSignals::read_signal(DeviceKind device, const drivers::ProfileSignal&
   switch (device) {
     case DeviceKind::synrm_drive: return synrm_value(s.name);
     case DeviceKind::load_drive: return load_value(s.name);
-    case DeviceKind::vfc_meter: return meter_value(s.name);
+    case DeviceKind::vfc_meter:
+      if (const auto v = instruments_.value(twin_, s)) return *v;
+      return meter_value(s.name);
   }
   return 0;
 }
@@ -275,6 +280,7 @@ void TwinSignals::advance(std::int64_t steps) {
     twin_.run_steps(n);
     steps -= n;
     check_watchdogs();
+    instruments_.update(twin_);
     if (window_active_ && !twin_.window_open()) close_window();
   }
 }

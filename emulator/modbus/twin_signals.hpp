@@ -14,6 +14,7 @@
 #include "drivers/devices.hpp"
 #include "drivers/profile/device_profile.hpp"
 #include "emulator/modbus/signal_provider.hpp"
+#include "emulator/modbus/twin_instruments.hpp"
 #include "emulator/twin.hpp"
 
 namespace synbench::emulator {
@@ -35,6 +36,8 @@ class TwinSignals final : public SignalProvider {
   };
   WindowState window(drivers::DeviceKind device) const { return dev_[index(device)].window; }
   std::uint64_t watchdog_trips() const { return watchdog_trips_; }
+  // The meter's totalizers and power meter (meter profiles "totalizer" and "power").
+  TwinInstruments& instruments() { return instruments_; }
   // Overrides the profiles' heartbeat timeout of both drives (twin time). At a time scale X
   // the master's scheduling jitter counts X times over; a CI run at 20x may want a longer one.
   void set_watchdog_timeout_s(double timeout_s) {
@@ -73,6 +76,7 @@ class TwinSignals final : public SignalProvider {
   drivers::SynrmWindow synrm_window_;
   drivers::LoadWindow load_window_;
   drivers::MeterReading meter_window_;
+  TwinInstruments instruments_;
 };
 
 }  // namespace synbench::emulator

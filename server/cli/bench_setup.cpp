@@ -131,6 +131,8 @@ class ConfiguredBackend final : public app::BenchBackend {
       : description_(b.config.on_twin() ? twin_description(twin) : bench_description(b.config)),
         bench_(b.config, std::move(b.profiles), twin) {
     if (b.config.on_twin()) description_.poll_period_s = b.config.poll_period_ms / 1000;
+    const drivers::DeviceProfile& synrm = bench_.bench().synrm().profile();
+    if (!synrm.find("temp_C")) description_.synrm_without_temperature = synrm.name;
   }
   drivers::BenchDevices devices() override { return bench_.bench().devices(); }
   drivers::Clock& clock() override { return bench_.bench().clock(); }

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
+#include <stdexcept>
 #include <sstream>
 #include <thread>
 
@@ -45,6 +47,8 @@ register maps (at most one; default: the default profiles, drivers/profiles/):
   --profiles DIR         the profiles in DIR: every *.json there whose top level has a "kind" is a
                          profile (others are skipped); exactly one synrm_drive, load_drive and
                          vfc_meter profile. Their unit ids, addresses and encodings are served
+                         (drives without window signals, a totalizer or power meter too:
+                         docs/device-profile.md)
   --bench CONFIG         the three profiles a bench config names, at its unit ids (its links are
                          not used: every device is served on each link given here, so their
                          registers must not collide)

@@ -19,6 +19,7 @@
 #include "db/store.hpp"
 #include "drivers/json_file.hpp"
 #include "app/bench_backend.hpp"
+#include "app/plan_needs.hpp"
 #include "app/supervised_point.hpp"
 #include "app/sweep_run.hpp"
 #include "emulator/twin_config_schema.hpp"
@@ -184,6 +185,17 @@ int sweep_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
+  // A plan the bench's profiles cannot serve is refused before anything is stored (a resumed
+  // plan is checked once read back, below).
+  if (plan && loaded) {
+    app::BenchDescription needs;
+    if (!loaded->profiles.synrm_drive.find("temp_C")) needs.synrm_without_temperature = loaded->profiles.synrm_drive.name;
+    if (auto unmet = app::unmet_plan_needs(*plan, needs)) {
+      std::cerr << "synbench sweep: refused before the start: " << *unmet << "\n";
+      return 2;
+    }
+  }
+
   // Checked before the bench moves: damaged pages and a file that cannot be written are refused.
   db::StoreOptions store_options;
   store_options.verify = true;
@@ -244,6 +256,10 @@ int sweep_command(const std::vector<std::string>& argv) {
 
   auto backend = make_backend(std::move(loaded), config);
   const app::BenchDescription& bench = backend->description();
+  if (auto unmet = app::unmet_plan_needs(*plan, bench)) {
+    std::cerr << "synbench sweep: refused before the start: " << *unmet << "\n";
+    return 1;
+  }
   bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [&](const std::string& k, const std::string& m) {
     (void)store.add_event(id, k == "fault" || k == "alarm" ? db::EventKind::fault : db::EventKind::state, m);
     if (!quiet && k == "alarm") std::cerr << "ALARM: " << m << "\n";

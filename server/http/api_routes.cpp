@@ -132,7 +132,7 @@ nlohmann::json status_json(const BenchStatus& s) {
     const auto& t = *s.synrm;
     j["synrm"] = {{"speed_rpm", t.speed_rpm}, {"im_A", t.im_A},     {"id_A", t.id_A},     {"iq_A", t.iq_A},
                   {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
-                  {"temp_C", t.temp_C},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
+                  {"temp_C", t.temp_C ? nlohmann::json(*t.temp_C) : nlohmann::json(nullptr)},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
                   {"pos_err_deg", t.pos_err_deg ? nlohmann::json(*t.pos_err_deg) : nlohmann::json(nullptr)},
                   {"state", drivers::state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
   } else {
@@ -176,7 +176,8 @@ std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint6
     gauge("synbench_synrm_speed_rpm", "SynRM speed.", s.synrm->speed_rpm);
     gauge("synbench_synrm_current_A", "SynRM current magnitude.", s.synrm->im_A);
     gauge("synbench_synrm_udc_V", "DC-bus voltage at the SynRM drive.", s.synrm->udc_V);
-    gauge("synbench_synrm_temp_C", "SynRM winding temperature.", s.synrm->temp_C);
+    // No gauge without a sensor: a scraped 0 would read as a cold winding.
+    if (s.synrm->temp_C) gauge("synbench_synrm_temp_C", "SynRM winding temperature.", *s.synrm->temp_C);
     gauge("synbench_synrm_pac_W", "SynRM drive output power estimate.", s.synrm->pac_W);
   }
   if (s.load) gauge("synbench_load_torque_Nm", "Braking torque of the load machine.", s.load->torque_Nm);

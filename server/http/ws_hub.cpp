@@ -32,7 +32,7 @@ std::string telemetry_message(const BenchStatus& s, double sent_unix_ms) {
   j["udc_V"] = s.synrm ? nlohmann::json(s.synrm->udc_V) : null;
   // The drive's own estimate of its output power, 1.5 (ud id + uq iq): not a DC-side measurement.
   j["pac_W"] = s.synrm ? nlohmann::json(s.synrm->pac_W) : null;
-  j["temp_C"] = s.synrm ? nlohmann::json(s.synrm->temp_C) : null;
+  j["temp_C"] = s.synrm && s.synrm->temp_C ? nlohmann::json(*s.synrm->temp_C) : null;
   j["pos_err_deg"] = s.synrm && s.synrm->pos_err_deg ? nlohmann::json(*s.synrm->pos_err_deg) : null;
   j["voltage_limited"] = s.synrm ? nlohmann::json(s.synrm->voltage_limited) : null;
   j["lock_lost"] = s.synrm ? nlohmann::json(s.synrm->lock_lost) : null;

@@ -159,10 +159,12 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
     r.below_min_speed = true;
     r.fallback_fraction = 0.9;
     r.lock_lost = true;
+    r.window_source = drivers::WindowKeeper::host;
     ASSERT_TRUE(store->insert_point(id, 0, r));
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN window_source");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
@@ -179,6 +181,7 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   EXPECT_FALSE(rows[0].record.below_min_speed);
   EXPECT_EQ(rows[0].record.fallback_fraction, 0.0);
   EXPECT_FALSE(rows[0].record.lock_lost);
+  EXPECT_EQ(rows[0].record.window_source, drivers::WindowKeeper::device);
   EXPECT_EQ(rows[0].record.im_A, testing::sample_record(3).im_A);
 }
 
@@ -199,6 +202,7 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN window_source");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
@@ -206,7 +210,7 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
   }
   auto store = Store::open(path);
   ASSERT_TRUE(store) << store.error().message;
-  EXPECT_EQ(store->pragma("user_version").value(), "4");
+  EXPECT_EQ(store->pragma("user_version").value(), std::to_string(schema_version()));
   EXPECT_EQ(Raw(path).column("SELECT coalesce(owner_pid, 'NULL') FROM sweeps"), std::vector<std::string>{"NULL"});
   const auto left = store->abort_left_running().value();
   ASSERT_EQ(left.size(), 1u);
@@ -264,7 +268,7 @@ TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
   const auto path = dir / "schema.db";
   { ASSERT_TRUE(Store::open(path)); }
   // Version 1's columns, then those later migrations added (ALTER TABLE appends them).
-  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost"};
+  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "window_source"};
   const auto n_added = static_cast<std::ptrdiff_t>(added.size());
   ASSERT_EQ(std::vector<std::string>(record_fields.end() - n_added, record_fields.end()), added);
   std::vector<std::string> expected{"id", "sweep_id", "point_index"};

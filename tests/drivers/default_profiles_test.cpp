@@ -57,10 +57,20 @@ TEST(DefaultProfiles, EachParsesAsItsKindWithEveryCatalogueSignal) {
   for (const DeviceKind kind : kDeviceKinds) {
     const DeviceProfile p = load_default(kind);
     EXPECT_EQ(p.kind, kind);
-    // The firmware implements the whole catalogue, optional signals included.
-    for (const SignalSpec& spec : signal_catalogue(kind))
-      EXPECT_NE(p.find(spec.name), nullptr) << name(kind) << " lacks " << spec.name;
-    EXPECT_EQ(p.signals.size(), signal_catalogue(kind).size());
+    // The firmware implements the whole catalogue, optional signals included, but for the signals
+    // of the meter kinds other than its gate (the emulator serves those through test profiles).
+    std::size_t others = 0;
+    for (const SignalSpec& spec : signal_catalogue(kind)) {
+      const bool other_meter = kind == DeviceKind::vfc_meter &&
+                               (spec.name.starts_with("total") || spec.name == "time_base_ticks" ||
+                                spec.name.starts_with("pdc"));
+      others += other_meter ? 1 : 0;
+      if (other_meter)
+        EXPECT_EQ(p.find(spec.name), nullptr) << name(kind) << " maps " << spec.name;
+      else
+        EXPECT_NE(p.find(spec.name), nullptr) << name(kind) << " lacks " << spec.name;
+    }
+    EXPECT_EQ(p.signals.size(), signal_catalogue(kind).size() - others);
   }
 }
 

@@ -108,7 +108,7 @@ const std::vector<InvalidCase> kInvalid = {
     {"unit_mismatch", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["unit"] = "ms"; },
      "/signals/gate_s/unit", "must be 's'"},
     {"missing_required_signal", DeviceKind::vfc_meter, [](json& d) { d["signals"].erase("counts_g"); },
-     "/signals/counts_g", "required signal of kind vfc_meter is missing"},
+     "/signals/counts_g", "required for meter gate"},
     {"missing_required_heartbeat", DeviceKind::load_drive, [](json& d) { d["signals"].erase("heartbeat"); },
      "/signals/heartbeat", "required signal of kind load_drive is missing"},
     {"unknown_signal", DeviceKind::vfc_meter,

@@ -55,7 +55,8 @@ TEST(ProfileSynrmDrive, ReadsTelemetryInThreeRequests) {
   EXPECT_EQ(t.state, DriveState::running);
   EXPECT_DOUBLE_EQ(t.speed_rpm, 700.25);
   EXPECT_NEAR(t.udc_V, 424.5, 1e-9);
-  EXPECT_NEAR(t.temp_C, 50.0, 1e-9);
+  ASSERT_TRUE(t.temp_C);
+  EXPECT_NEAR(*t.temp_C, 50.0, 1e-9);
   EXPECT_TRUE(t.voltage_limited);
 }
 
