@@ -55,6 +55,7 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["below_min_speed"] = r.below_min_speed;
   j["fallback_fraction"] = r.fallback_fraction;
   j["lock_lost"] = r.lock_lost;
+  j["fault_code_raw"] = r.fault_code_raw ? nlohmann::ordered_json(*r.fault_code_raw) : nlohmann::ordered_json(nullptr);
   if (r.truth) {
     const auto& t = *r.truth;
     j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},

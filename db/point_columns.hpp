@@ -20,14 +20,15 @@ using bench::PointRecord;
 using Member = std::variant<double PointRecord::*, std::optional<double> PointRecord::*,
                             drivers::Estimator PointRecord::*, drivers::Pwm PointRecord::*,
                             std::uint32_t PointRecord::*, bool PointRecord::*,
-                            std::optional<std::string> PointRecord::*>;
+                            std::optional<std::string> PointRecord::*,
+                            std::optional<std::int64_t> PointRecord::*>;
 
 struct RecordColumn {
   std::string_view name;
   Member member;
 };
 
-inline const std::array<RecordColumn, 38> kRecordColumns{{
+inline const std::array<RecordColumn, 39> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
@@ -66,6 +67,7 @@ inline const std::array<RecordColumn, 38> kRecordColumns{{
     {"below_min_speed", &PointRecord::below_min_speed},    // schema version 2
     {"fallback_fraction", &PointRecord::fallback_fraction},
     {"lock_lost", &PointRecord::lock_lost},                // schema version 3
+    {"fault_code_raw", &PointRecord::fault_code_raw},      // schema version 5
 }};
 
 }  // namespace synbench::db::detail

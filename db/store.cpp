@@ -102,6 +102,7 @@ void bind_record(Statement& st, int first, const bench::PointRecord& r) {
                    [&](std::uint32_t bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m}); },
                    [&](bool bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m ? 1 : 0}); },
                    [&](std::optional<std::string> bench::PointRecord::*m) { st.bind(i, r.*m); },
+                   [&](std::optional<std::int64_t> bench::PointRecord::*m) { st.bind(i, r.*m); },
                },
                c.member);
     ++i;
@@ -146,6 +147,10 @@ Status read_record(const Statement& st, int first, bench::PointRecord& r) {
             },
             [&](std::optional<std::string> bench::PointRecord::*m) -> Status {
               r.*m = st.opt_text(i);
+              return {};
+            },
+            [&](std::optional<std::int64_t> bench::PointRecord::*m) -> Status {
+              r.*m = st.is_null(i) ? std::nullopt : std::optional<std::int64_t>(st.integer(i));
               return {};
             },
         },

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <system_error>
 
 #include "drivers/devices.hpp"
@@ -25,20 +26,27 @@ class ProfileDevice {
   const DeviceProfile& profile() const { return profile_; }
   SignalIo& io() { return io_; }
   WindowChannel& window() { return window_; }
-  // Sends the heartbeat when due; errors are counted, the next tick retries.
-  std::error_code tick(double now_s) { return heartbeat_.tick(now_s, io_); }
-  double next_heartbeat_s() const { return heartbeat_.next_due_s(); }
+  // Sends the watchdog's refresh when due (unless `feed_watchdog` is false) and ends a reset
+  // pulse whose time is up; errors are counted, the next tick retries.
+  std::error_code tick(double now_s, bool feed_watchdog = true);
+  // When tick() has something to do next (the watchdog's refresh counted only when fed).
+  double next_heartbeat_s(bool feed_watchdog = true) const;
   std::uint64_t heartbeat_failures() const { return heartbeat_.failures(); }
+  // What the last failed call ran into, in the device's terms (SignalIo::last_error).
+  std::string device_error() const { return io_.last_error(); }
 
  protected:
-  // Writes 1 to the fault-reset signal.
-  std::error_code pulse_fault_reset() { return io_.write("fault_reset", 1); }
+  // Writes 1 to the fault-reset signal; with a pulse reset the next ticks write 0 after pulse_ms.
+  std::error_code pulse_fault_reset();
 
  private:
   DeviceProfile profile_;
   SignalIo io_;
   Heartbeat heartbeat_;
   WindowChannel window_;
+  // A pulse reset's 1 is held: cleared at reset_clear_s_ (NaN: from the next tick's time).
+  bool reset_held_ = false;
+  double reset_clear_s_ = 0;
 };
 
 class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
@@ -56,6 +64,7 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   std::error_code reset_fault() override;
   std::error_code read(SynrmTelemetry& out) override;
   std::error_code read_window(SynrmWindow& out) override;
+  std::string error_detail() const override { return device_error(); }
 
  private:
   ReadPlan telemetry_, window_, estimator_window_;
@@ -71,6 +80,7 @@ class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
   std::error_code reset_fault() override;
   std::error_code read(LoadTelemetry& out) override;
   std::error_code read_window(LoadWindow& out) override;
+  std::string error_detail() const override { return device_error(); }
 
  private:
   ReadPlan telemetry_, window_;
@@ -81,6 +91,7 @@ class ProfileMeter final : public PowerMeter, public ProfileDevice {
   ProfileMeter(RegisterBus& bus, DeviceProfile profile);
   // The gate of the last window; errc::not_ready while it is open.
   std::error_code read(MeterReading& out) override;
+  std::string error_detail() const override { return device_error(); }
 
  private:
   ReadPlan gate_;

@@ -25,6 +25,8 @@ class TwinSignals final : public SignalProvider {
 
   double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) override;
   std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) override;
+  // With an any_write watchdog every accepted write restarts the device's timeout.
+  void accepted_write(drivers::DeviceKind device) override;
 
   // Runs the twin `steps` periods, checking the watchdogs and the window every millisecond.
   void advance(std::int64_t steps);
@@ -47,12 +49,19 @@ class TwinSignals final : public SignalProvider {
     double heartbeat = 0;
     double heartbeat_change_s = 0;
     double timeout_s = 0;  // 0: no watchdog
+    drivers::WatchdogKind watchdog = drivers::WatchdogKind::none;
+    // A pulse-reset profile: the firmware resets on a rising edge of fault_reset only, and the
+    // register holds the level written.
+    bool reset_on_edge = false;
+    double reset_level = 0;
     double window_length_ms = 1000;
     bool in_window = false;
     WindowState window;
   };
   static std::size_t index(drivers::DeviceKind k) { return static_cast<std::size_t>(k); }
   bool drive_enabled(drivers::DeviceKind k) const;
+  // Whether a write of `v` to fault_reset resets the drive (and keeps the level it leaves).
+  bool reset_requested(Device& d, double v);
   void check_watchdogs();
   void close_window();
   std::error_code start_window(drivers::DeviceKind k);

@@ -75,6 +75,12 @@ std::string ConfiguredBench::link_errors() const {
   std::string s;
   for (const auto& [name, bus] : buses_)
     if (!bus->last_error().empty()) s += "  " + bus->last_error() + "\n";
+  // A reply that arrived but could not be read as the profile says: signal, register, raw words.
+  if (bench_)
+    for (const drivers::ProfileDevice* d : {static_cast<const drivers::ProfileDevice*>(&bench_->synrm()),
+                                            static_cast<const drivers::ProfileDevice*>(&bench_->load()),
+                                            static_cast<const drivers::ProfileDevice*>(&bench_->meter())})
+      if (!d->device_error().empty()) s += "  " + d->device_error() + "\n";
   return s;
 }
 

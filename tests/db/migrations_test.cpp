@@ -166,6 +166,7 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
+    raw.exec("ALTER TABLE points DROP COLUMN fault_code_raw");
     raw.exec("ALTER TABLE points DROP COLUMN lock_lost");
     raw.exec("ALTER TABLE points DROP COLUMN fallback_fraction");
     raw.exec("ALTER TABLE points DROP COLUMN below_min_speed");
@@ -202,11 +203,12 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
+    raw.exec("ALTER TABLE points DROP COLUMN fault_code_raw");
     raw.exec("PRAGMA user_version = 3");
   }
   auto store = Store::open(path);
   ASSERT_TRUE(store) << store.error().message;
-  EXPECT_EQ(store->pragma("user_version").value(), "4");
+  EXPECT_EQ(store->pragma("user_version").value(), std::to_string(schema_version()));
   EXPECT_EQ(Raw(path).column("SELECT coalesce(owner_pid, 'NULL') FROM sweeps"), std::vector<std::string>{"NULL"});
   const auto left = store->abort_left_running().value();
   ASSERT_EQ(left.size(), 1u);
@@ -264,7 +266,7 @@ TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
   const auto path = dir / "schema.db";
   { ASSERT_TRUE(Store::open(path)); }
   // Version 1's columns, then those later migrations added (ALTER TABLE appends them).
-  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost"};
+  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "fault_code_raw"};
   const auto n_added = static_cast<std::ptrdiff_t>(added.size());
   ASSERT_EQ(std::vector<std::string>(record_fields.end() - n_added, record_fields.end()), added);
   std::vector<std::string> expected{"id", "sweep_id", "point_index"};
