@@ -1,12 +1,15 @@
 // A fault code the bench's profile has no label for, read through the profile from the twin's
 // register server: it reaches the safety supervisor as the fault "unknown" with the device's
 // code, is recorded so, and ends in the ordered stop (the load comes off, the shaft stops),
-// where a decode error used to leave the load braking.
+// where a decode error used to leave the load braking. And a value that cannot be decoded at all
+// fails the point with a message that says where.
 #include "bench/safety_supervisor.hpp"
+#include "bench/point_procedure.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -84,6 +87,33 @@ TEST(UnknownFault, StopsTheBenchInOrderAndCarriesTheDevicesCode) {
   ASSERT_FALSE(d.synrm->read(st)) << d.synrm->error_detail();
   EXPECT_EQ(st.fault, drivers::Fault::unknown);
   EXPECT_EQ(st.fault_code_raw, 0x2310);
+}
+
+TEST(DecodeError, APointThatCannotReadItsDriveSaysWhereAndWhat) {
+  // The drive reports running as 3 under mask 0x000B; the bench's profile has no code for it.
+  json used = t::vendor_synrm(t::pulse_reset(100), json());
+  used["signals"]["state"]["values"].erase("running");
+  used["signals"]["state"].erase("otherwise");
+  std::vector<drivers::DeviceProfile> served{
+      t::parse_or_throw(t::vendor_synrm(t::pulse_reset(100), json())),
+      t::parse_or_throw(t::default_profile_doc(DeviceKind::load_drive)),
+      t::parse_or_throw(t::default_profile_doc(DeviceKind::vfc_meter))};
+  emulator::TwinService service{emulator::TwinConfig{}, served};
+  emulator::TwinRegisterBus bus{service};
+  emulator::TwinServiceClock base{service};
+  drivers::ProfileBench bench{bus, t::parse_or_throw(used), bus, served[1], bus, served[2], base};
+  PointRequest req;
+  req.speed_rpm = 500;
+  req.load_Nm = 1.0;
+  req.angle_deg = 56;
+  const PointProcedure proc = run_point(bench.devices(), bench.clock(), req, PointOptions{});
+  EXPECT_FALSE(proc.error().empty());
+  EXPECT_NE(proc.error().find("reading SynRM drive telemetry"), std::string::npos) << proc.error();
+  EXPECT_NE(proc.error().find("synrm_drive 'vendor SynRM drive': signal state (input 40 mask 11, unit id 1): raw "),
+            std::string::npos)
+      << proc.error();
+  EXPECT_NE(proc.error().find("device code 3 has no label"), std::string::npos) << proc.error();
+  std::printf("  %s\n", proc.error().c_str());
 }
 
 }  // namespace
