@@ -35,6 +35,8 @@ class ProfileBench {
   // Sends the heartbeats due at `now_s` (none while they are stopped).
   void tick(double now_s);
   double next_heartbeat_s() const;
+  // Whether a drive's reset pulse is still held (tick() ends it).
+  bool resets_pending() const { return synrm_.reset_pending() || load_.reset_pending(); }
   // Stops or resumes the heartbeats: stopped, the drives' watchdogs stop the drives on their own.
   void set_heartbeats(bool on) { heartbeats_ = on; }
   bool heartbeats() const { return heartbeats_; }

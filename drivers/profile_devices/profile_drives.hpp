@@ -32,6 +32,7 @@ class ProfileDevice {
   // When tick() has something to do next (the watchdog's refresh counted only when fed).
   double next_heartbeat_s(bool feed_watchdog = true) const;
   std::uint64_t heartbeat_failures() const { return heartbeat_.failures(); }
+  bool reset_pending() const { return reset_held_; }
   // What the last failed call ran into, in the device's terms (SignalIo::last_error).
   std::string device_error() const { return io_.last_error(); }
 

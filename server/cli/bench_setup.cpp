@@ -141,6 +141,7 @@ class ConfiguredBackend final : public app::BenchBackend {
   drivers::BenchDevices devices() override { return bench_.bench().devices(); }
   drivers::Clock& clock() override { return bench_.bench().clock(); }
   void tick(double now_s) override { bench_.bench().tick(now_s); }
+  bool ticks_pending() const override { return bench_.bench().resets_pending(); }
   void set_heartbeats(bool on) override { bench_.bench().set_heartbeats(on); }
   bool heartbeats() const override { return bench_.bench().heartbeats(); }
   nlohmann::json describe() const override { return bench_.describe_devices(); }
