@@ -22,6 +22,9 @@ class BenchBackend {
   virtual drivers::Clock& clock() = 0;
   // Periodic link work due at `now_s` (the drives' watchdog heartbeats).
   virtual void tick(double /*now_s*/) {}
+  // Whether tick() still has a command to finish (a reset pulse to end): a process that exits
+  // right after a reset waits for it, or an edge-triggered drive's next reset is no edge.
+  virtual bool ticks_pending() const { return false; }
   // Stops or resumes the heartbeats. An E-stop stops them, so that a drive the disable did not
   // reach is stopped by its own watchdog; they resume on a reset.
   // (A bench without a watchdog, the in-process twin, only keeps the flag.)

@@ -34,6 +34,8 @@ PointProcedure::PointProcedure(drivers::BenchDevices devices, PointRequest reque
 bool PointProcedure::check(std::error_code ec, const char* what) {
   if (!ec) return true;
   error_ = std::string(what) + ": " + ec.message();
+  // The device's own words (signal, register, raw words) where it has them.
+  if (!detail_.empty()) error_ += " (" + detail_ + ")";
   phase_ = PointPhase::failed;
   return false;
 }
@@ -53,6 +55,7 @@ bool PointProcedure::tolerate(std::error_code ec, const char* what, double now_s
 bool PointProcedure::command(std::error_code ec, const char* what, double now_s, double& failing_since_s) {
   if (!ec) return true;
   if (failing_since_s < 0) failing_since_s = now_s;
+  detail_.clear();
   tolerate(ec, what, now_s, failing_since_s);
   return false;
 }
@@ -113,9 +116,11 @@ void PointProcedure::tick(double now_s) {
   if (phase_ != PointPhase::start) {
     std::error_code ec = dev_.synrm->read(st);
     const char* what = "reading SynRM drive telemetry";
+    detail_ = ec ? dev_.synrm->error_detail() : std::string();
     if (!ec) {
       ec = dev_.load->read(lt);
       what = "reading load drive telemetry";
+      if (ec) detail_ = dev_.load->error_detail();
     }
     // A lost read skips the tick: nothing is decided on telemetry that did not arrive.
     if (ec) {
@@ -124,12 +129,14 @@ void PointProcedure::tick(double now_s) {
     }
     t_last_read_ = now_s;
     const auto fault = st.fault != drivers::Fault::none ? st.fault : lt.fault;
+    const auto fault_code_raw = st.fault != drivers::Fault::none ? st.fault_code_raw : lt.fault_code_raw;
     const bool ramping_off = phase_ == PointPhase::stop && stop_ramped_ && stop_.step() == StopStep::load;
     if (fault != drivers::Fault::none && (phase_ != PointPhase::stop || ramping_off)) {
       // A fault during the ramped stop of a measured point takes the load off at once too.
       if (phase_ != PointPhase::stop) {
         record_.fault = std::string(drivers::fault_name(fault));
-        error_ = "fault latched during the point: " + *record_.fault;
+        record_.fault_code_raw = fault_code_raw;
+        error_ = "fault latched during the point: " + drivers::describe_fault(fault, fault_code_raw);
       }
       begin_stop(now_s, /*ramped=*/false);
       return;
@@ -147,12 +154,13 @@ void PointProcedure::tick(double now_s) {
     case PointPhase::start: {
       t_start_ = now_s;
       if (const auto ec = dev_.synrm->read(st)) {
+        detail_ = dev_.synrm->error_detail();
         tolerate(ec, "reading SynRM drive telemetry", now_s, t_last_read_);
         return;
       }
       t_last_read_ = now_s;
       if (st.fault != drivers::Fault::none) {
-        error_ = "SynRM drive has a latched fault (" + std::string(drivers::fault_name(st.fault)) +
+        error_ = "SynRM drive has a latched fault (" + drivers::describe_fault(st.fault, st.fault_code_raw) +
                  "); reset it first";
         phase_ = PointPhase::failed;
         return;
@@ -161,6 +169,7 @@ void PointProcedure::tick(double now_s) {
         // Retarget a running bench: everything at once (the load at its ramp, from the setpoint
         // in force), then let the gate judge.
         if (const auto ec = dev_.load->read(lt)) {
+          detail_ = dev_.load->error_detail();
           tolerate(ec, "reading load drive telemetry", now_s, t_last_read_);
           return;
         }
@@ -311,11 +320,11 @@ std::error_code PointProcedure::read_results(const char*& what) {
   drivers::LoadWindow lw;
   drivers::MeterReading m;
   what = "reading the SynRM drive window";
-  if (auto ec = dev_.synrm->read_window(w)) return ec;
+  if (auto ec = dev_.synrm->read_window(w)) return detail_ = dev_.synrm->error_detail(), ec;
   what = "reading the load drive window";
-  if (auto ec = dev_.load->read_window(lw)) return ec;
+  if (auto ec = dev_.load->read_window(lw)) return detail_ = dev_.load->error_detail(), ec;
   what = "reading the power meter";
-  if (auto ec = dev_.meter->read(m)) return ec;
+  if (auto ec = dev_.meter->read(m)) return detail_ = dev_.meter->error_detail(), ec;
   if (const auto why = implausible_window(w, lw, m)) {
     error_ = "implausible window result, point not stored: " + *why;
     return {};
@@ -364,7 +373,10 @@ std::error_code PointProcedure::read_results(const char*& what) {
   r.fallback_fraction = w.fallback_fraction;
   r.below_min_speed = w.fallback_fraction > 0.5;
   if (w.lock_lost_fraction > 0) r.lock_lost = true;
-  if (w.fault != drivers::Fault::none) r.fault = std::string(drivers::fault_name(w.fault));
+  if (w.fault != drivers::Fault::none) {
+    r.fault = std::string(drivers::fault_name(w.fault));
+    r.fault_code_raw = w.fault_code_raw;
+  }
   if (dev_.truth) r.truth = dev_.truth->read_truth_window();
   has_record_ = true;
   return {};

@@ -130,6 +130,7 @@ class PointProcedure {
   double t_step_failing_ = -1;  // a command of the current step failing on the link since
   double t_ramp_failing_ = -1;  // the load ramp's writes failing since
   std::uint64_t tolerated_reads_ = 0;
+  std::string detail_;  // the failing device's error_detail(), added to error_ by check()
   bool load_pending_ = false;
   OrderedStop stop_;
   bool stop_ramped_ = false;  // the stop takes the load off at the ramp (a measured point)

@@ -56,6 +56,7 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["fallback_fraction"] = r.fallback_fraction;
   j["lock_lost"] = r.lock_lost;
   j["window_source"] = drivers::keeper_name(r.window_source);
+  j["fault_code_raw"] = r.fault_code_raw ? nlohmann::ordered_json(*r.fault_code_raw) : nlohmann::ordered_json(nullptr);
   if (r.truth) {
     const auto& t = *r.truth;
     j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},

@@ -41,6 +41,8 @@ struct PointRecord {
   // The estimator lost the rotor during the point: the drive's lock guard ran it on the encoder
   // from then on, so its values are not the estimator's (docs/estimators.md).
   bool lock_lost = false;
+  // The device's own code of a fault its profile has no label for (fault "unknown").
+  std::optional<std::int64_t> fault_code_raw;
   // emulator only: the plant's own values over the window
   std::optional<drivers::TruthWindow> truth;
 };

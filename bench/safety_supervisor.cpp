@@ -33,9 +33,10 @@ SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits l
                                    EventSink sink)
     : dev_(devices), lim_(limits), sink_(std::move(sink)), plausibility_(limits.plausibility) {}
 
-void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string detail) {
+void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string detail,
+                             std::optional<std::int64_t> fault_code_raw) {
   if (trip_) return;  // the first cause is the one that counts
-  trip_ = SafetyTrip{fault, std::move(detail), now_s};
+  trip_ = SafetyTrip{fault, std::move(detail), now_s, fault_code_raw};
   if (sink_)
     sink_("fault", std::string(drivers::fault_name(fault)) + ": " + trip_->detail);
   // At once (the load drive's own ramp): a trip does not wait on a ramp.
@@ -59,7 +60,7 @@ void SafetySupervisor::estop(double now_s, const std::string& why) {
   stop_.cancel();
   disable_all();
   if (!trip_) {
-    trip_ = SafetyTrip{drivers::Fault::estop, why, now_s};
+    trip_ = SafetyTrip{drivers::Fault::estop, why, now_s, std::nullopt};
     if (sink_) sink_("fault", "estop: " + why);
   }
   phase_ = SafetyPhase::estopped;
@@ -141,7 +142,10 @@ void SafetySupervisor::tick(double now_s) {
 
   if (synrm_ && !trip_) {
     const auto& s = *synrm_;
-    if (s.fault != drivers::Fault::none)
+    if (s.fault == drivers::Fault::unknown)
+      raise(now_s, s.fault, "SynRM drive reports " + drivers::describe_fault(s.fault, s.fault_code_raw),
+            s.fault_code_raw);
+    else if (s.fault != drivers::Fault::none)
       raise(now_s, s.fault, "SynRM drive reports its own trip");
     else if (std::fabs(s.speed_rpm) > lim_.max_speed_rpm)
       raise(now_s, drivers::Fault::overspeed, format("speed %.0f rpm > %.0f rpm", std::fabs(s.speed_rpm), lim_.max_speed_rpm));
@@ -155,7 +159,8 @@ void SafetySupervisor::tick(double now_s) {
       raise(now_s, drivers::Fault::overtemperature, format("winding %.1f degC > %.1f degC", *s.temp_C, lim_.max_temp_C));
   }
   if (load_ && !trip_ && load_->fault != drivers::Fault::none)
-    raise(now_s, drivers::Fault::load_drive, "load drive reports " + std::string(drivers::fault_name(load_->fault)));
+    raise(now_s, drivers::Fault::load_drive, "load drive reports " + drivers::describe_fault(load_->fault, load_->fault_code_raw),
+          load_->fault_code_raw);
   if (synrm_ && !trip_)
     if (const auto bad = plausibility_.check(now_s, *synrm_))
       raise(now_s, drivers::Fault::implausible_telemetry, "SynRM drive " + bad->describe());

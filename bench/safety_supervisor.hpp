@@ -41,6 +41,7 @@ struct SafetyTrip {
   drivers::Fault fault = drivers::Fault::none;
   std::string detail;   // e.g. "speed 1712 rpm > 1650 rpm"
   double at_s = 0;      // when it was detected
+  std::optional<std::int64_t> fault_code_raw;  // a drive's code of an unknown fault
 };
 
 enum class SafetyPhase { normal, stopping_load, stopping_speed, stopped, estopped };
@@ -90,7 +91,8 @@ class SafetySupervisor {
   std::optional<double> stop_duration_s() const { return stop_duration_s_; }
 
  private:
-  void raise(double now_s, drivers::Fault fault, std::string detail);
+  void raise(double now_s, drivers::Fault fault, std::string detail,
+             std::optional<std::int64_t> fault_code_raw = std::nullopt);
   void advance_stop(double now_s);
   void disable_all();
   void confirm_stop(double now_s);

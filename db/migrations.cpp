@@ -119,12 +119,19 @@ constexpr std::string_view kSchemaV5 = R"sql(
 ALTER TABLE points ADD COLUMN window_source TEXT NOT NULL DEFAULT 'device' CHECK (window_source IN ('device', 'host'));
 )sql";
 
+// Version 6: the device's own code of a fault its profile has no label for (fault "unknown");
+// NULL for every other fault and on rows from before.
+constexpr std::string_view kSchemaV6 = R"sql(
+ALTER TABLE points ADD COLUMN fault_code_raw INTEGER;
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
     Migration{3, "points: lock_lost", kSchemaV3},
     Migration{4, "sweeps: owner_host, owner_pid, owner_start", kSchemaV4},
     Migration{5, "points: window_source", kSchemaV5},
+    Migration{6, "points: fault_code_raw", kSchemaV6},
 };
 
 struct Header {

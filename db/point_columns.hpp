@@ -20,7 +20,8 @@ using bench::PointRecord;
 using Member = std::variant<double PointRecord::*, std::optional<double> PointRecord::*,
                             drivers::Estimator PointRecord::*, drivers::Pwm PointRecord::*,
                             std::uint32_t PointRecord::*, bool PointRecord::*,
-                            std::optional<std::string> PointRecord::*, drivers::WindowKeeper PointRecord::*>;
+                            std::optional<std::string> PointRecord::*, drivers::WindowKeeper PointRecord::*,
+                            std::optional<std::int64_t> PointRecord::*>;
 
 struct RecordColumn {
   std::string_view name;
@@ -67,6 +68,7 @@ inline const std::array<RecordColumn, 39> kRecordColumns{{
     {"fallback_fraction", &PointRecord::fallback_fraction},
     {"lock_lost", &PointRecord::lock_lost},                // schema version 3
     {"window_source", &PointRecord::window_source},        // schema version 5
+    {"fault_code_raw", &PointRecord::fault_code_raw},      // schema version 6
 }};
 
 }  // namespace synbench::db::detail

@@ -105,6 +105,7 @@ void bind_record(Statement& st, int first, const bench::PointRecord& r) {
                    [&](drivers::WindowKeeper bench::PointRecord::*m) {
                      st.bind(i, std::string_view(drivers::keeper_name(r.*m)));
                    },
+                   [&](std::optional<std::int64_t> bench::PointRecord::*m) { st.bind(i, r.*m); },
                },
                c.member);
     ++i;
@@ -156,6 +157,10 @@ Status read_record(const Statement& st, int first, bench::PointRecord& r) {
               if (v != "device" && v != "host")
                 return make_error(errc::bad_record, "unknown window_source \"" + v + "\"");
               r.*m = v == "host" ? drivers::WindowKeeper::host : drivers::WindowKeeper::device;
+              return {};
+            },
+            [&](std::optional<std::int64_t> bench::PointRecord::*m) -> Status {
+              r.*m = st.is_null(i) ? std::nullopt : std::optional<std::int64_t>(st.integer(i));
               return {};
             },
         },

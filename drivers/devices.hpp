@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <system_error>
 
 #include "drivers/fault.hpp"
@@ -50,6 +51,7 @@ struct SynrmTelemetry {
   bool lock_lost = false;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;
+  std::optional<std::int64_t> fault_code_raw;  // the device's code of an unknown fault
 };
 
 // Who kept a measurement window: the device (its window registers; samples are its control
@@ -80,6 +82,7 @@ struct SynrmWindow {
   std::optional<double> ld_ref_H, lq_ref_H, rs_ref_ohm;
   Fault fault = Fault::none;  // fault latched during the window, if any
   WindowKeeper keeper = WindowKeeper::device;
+  std::optional<std::int64_t> fault_code_raw;  // the device's code of an unknown fault
 };
 
 class SynrmDrive {
@@ -94,6 +97,9 @@ class SynrmDrive {
   virtual std::error_code read(SynrmTelemetry& out) = 0;
   // The result of the last closed window; errc::not_ready while it is open.
   virtual std::error_code read_window(SynrmWindow& out) = 0;
+  // What the last failed call ran into in the device's terms (signal, register, raw words),
+  // for the message that reports it; empty when there is nothing to add.
+  virtual std::string error_detail() const { return {}; }
 };
 
 struct LoadTelemetry {
@@ -101,6 +107,7 @@ struct LoadTelemetry {
   double iq_A = 0;
   DriveState state = DriveState::disabled;
   Fault fault = Fault::none;
+  std::optional<std::int64_t> fault_code_raw;  // the device's code of an unknown fault
 };
 
 struct LoadWindow {
@@ -118,6 +125,7 @@ class LoadDrive {
   virtual std::error_code reset_fault() = 0;
   virtual std::error_code read(LoadTelemetry& out) = 0;
   virtual std::error_code read_window(LoadWindow& out) = 0;
+  virtual std::string error_detail() const { return {}; }  // as SynrmDrive's
 };
 
 // VFC counts of the two DC-bus currents over the gate, and the currents the meter derives; or
@@ -139,6 +147,7 @@ class PowerMeter {
  public:
   virtual ~PowerMeter() = default;
   virtual std::error_code read(MeterReading& out) = 0;
+  virtual std::string error_detail() const { return {}; }  // as SynrmDrive's
 };
 
 // Opens one window on every device at once (hardware: a broadcast or a trigger line).

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace synbench::drivers {
@@ -23,6 +24,9 @@ enum class Fault : std::uint16_t {
   // working drive reports (a value frozen bit for bit, current into a shaft at rest, a negative
   // magnitude); bench/telemetry_plausibility.hpp.
   implausible_telemetry = 10,
+  // A device code its profile has no label for: a fault all the same (a drive that reports
+  // something is not fine); the raw code travels with it (fault_code_raw).
+  unknown = 11,
 };
 
 constexpr std::string_view fault_name(Fault f) {
@@ -38,8 +42,17 @@ constexpr std::string_view fault_name(Fault f) {
     case Fault::link_loss: return "link_loss";
     case Fault::load_drive: return "load_drive";
     case Fault::implausible_telemetry: return "implausible_telemetry";
+    case Fault::unknown: return "unknown";
   }
   return "unknown";
+}
+
+// For events and errors: the fault's name, and for an unknown one the device's code
+// ("unknown fault (device code 8721)").
+inline std::string describe_fault(Fault f, std::optional<std::int64_t> device_code) {
+  if (f == Fault::unknown)
+    return "unknown fault" + (device_code ? " (device code " + std::to_string(*device_code) + ")" : std::string());
+  return std::string(fault_name(f));
 }
 
 }  // namespace synbench::drivers

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -26,6 +27,8 @@ using nlohmann::json;
 
 constexpr std::array<std::string_view, 4> kRegisterKindNames{"coil", "discrete_input", "holding", "input"};
 constexpr std::array<std::string_view, 3> kAccessNames{"r", "w", "rw"};
+constexpr std::array<std::string_view, 3> kWatchdogNames{"counter", "any_write", "none"};
+constexpr std::int64_t kMaxMs = 3'600'000;
 
 constexpr int kMinUnitId = 1;
 constexpr int kMaxUnitId = 247;  // 0 is broadcast, 248..255 are reserved
@@ -135,6 +138,11 @@ class Parser {
   void limits(const json& obj, const std::string& path, bool scaling_valid, ProfileSignal& s);
   void enum_values(const SignalSpec& spec, const json& obj, const std::string& path, ProfileSignal& s);
   void heartbeat(const json& obj, const std::string& path, ProfileSignal& s);
+  void bit_mask(const json& obj, const std::string& path, ProfileSignal& s);
+  void otherwise(const SignalSpec& spec, const json& obj, const std::string& path, ProfileSignal& s);
+  void reset_mode(const json& obj, const std::string& path, ProfileSignal& s);
+  // Whether `value` fits the signal's encoding (and its field, for a masked signal).
+  static bool encodable(const ProfileSignal& s, double value);
 };
 
 std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const json& obj, const std::string& path,
@@ -145,7 +153,8 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const json& 
   }
   reject_unknown(obj, path,
                  {"unit_id", "register", "address", "type", "word_order", "byte_order", "scale", "offset",
-                  "unit", "access", "min", "max", "values", "period_ms", "timeout_ms"});
+                  "unit", "access", "min", "max", "values", "period_ms", "timeout_ms", "bit", "mask", "otherwise",
+                  "reset"});
   const std::size_t errors_before = errors.size();
 
   ProfileSignal s;
@@ -167,12 +176,15 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const json& 
                                    " carries a single bit, so it needs a holding or input register");
     if (const auto t = string_field(obj, path, "type", false); t && *t != "bool")
       fail(path + "/type", a_kind(s.kind) + " carries type bool, not " + in_quotes(*t));
-    for (const char* key : {"word_order", "byte_order", "scale", "offset", "min", "max", "values"})
+    for (const char* key : {"word_order", "byte_order", "scale", "offset", "min", "max", "values", "bit", "mask",
+                            "otherwise"})
       if (obj.contains(key))
         fail(path + "/" + key, "does not apply to " + a_kind(s.kind) + " (a single bit)");
   } else {
     register_encoding(obj, path, d, s);
+    bit_mask(obj, path, s);
     if (obj.contains("values")) enum_values(spec, obj, path, s);
+    if (obj.contains("otherwise")) otherwise(spec, obj, path, s);
   }
 
   if (address) {
@@ -208,8 +220,9 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const json& 
       fail(path + "/access", "the bench reads " + std::string(name(s.role)) + " signals; use r or rw");
   }
 
-  // An unbounded setpoint would let a typo command anything the raw type can carry.
-  if (s.kind == RegisterKind::holding && s.writable()) {
+  // An unbounded setpoint would let a typo command anything the raw type can carry; a masked
+  // field is bounded by its bits.
+  if (s.kind == RegisterKind::holding && s.writable() && !obj.contains("bit") && !obj.contains("mask")) {
     for (const char* key : {"min", "max"})
       if (!obj.contains(key)) fail(path + "/" + key, "required for a register the bench may write");
   }
@@ -220,6 +233,10 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const json& 
     for (const char* key : {"period_ms", "timeout_ms"})
       if (obj.contains(key)) fail(path + "/" + key, "applies to the heartbeat signal only");
   }
+  if (s.role == SignalRole::fault_reset)
+    reset_mode(obj, path, s);
+  else if (obj.contains("reset"))
+    fail(path + "/reset", "applies to the fault_reset signal only");
 
   if (errors.size() != errors_before) return std::nullopt;
   return s;
@@ -299,7 +316,7 @@ void Parser::enum_values(const SignalSpec& spec, const json& obj, const std::str
     return;
   }
   if (!values.is_object() || values.empty()) {
-    fail(vpath, "must be an object of label: value");
+    fail(vpath, "must be an object of label: code or label: [codes]");
     return;
   }
   std::map<std::int64_t, std::string> seen;
@@ -311,24 +328,107 @@ void Parser::enum_values(const SignalSpec& spec, const json& obj, const std::str
       fail(vp, "unknown label for " + s.name + " (expected " + known + ")");
       continue;
     }
-    if (!v.is_number_integer()) {
-      fail(vp, "must be an integer");
-      continue;
+    // One code, or several (the first is the one the bench writes).
+    std::vector<std::pair<std::string, const json*>> codes;
+    if (v.is_array()) {
+      if (v.empty()) fail(vp, "must list at least one code");
+      for (std::size_t i = 0; i < v.size(); ++i) codes.emplace_back(vp + "/" + std::to_string(i), &v[i]);
+    } else {
+      codes.emplace_back(vp, &v);
     }
-    const auto value = v.get<std::int64_t>();
-    std::uint16_t words[2];
-    if (encode_registers(s.encoding, static_cast<double>(value), words)) {
-      fail(vp, std::to_string(value) + " is outside the signal's limits or type");
-      continue;
+    bool first = true;
+    for (const auto& [cp, c] : codes) {
+      if (!c->is_number_integer()) {
+        fail(cp, "must be an integer or an array of integers");
+        continue;
+      }
+      const auto value = c->get<std::int64_t>();
+      if (!encodable(s, static_cast<double>(value))) {
+        fail(cp, std::to_string(value) + " is outside the signal's limits, type or bits");
+        continue;
+      }
+      if (const auto [it, inserted] = seen.emplace(value, label); !inserted) {
+        fail(cp, std::to_string(value) + " is also a code of " + in_quotes(it->second));
+        continue;
+      }
+      s.values.push_back({value, label, first});
+      first = false;
     }
-    if (const auto [it, inserted] = seen.emplace(value, label); !inserted)
-      fail(vp, std::to_string(value) + " is also the value of " + in_quotes(it->second));
   }
-  for (const auto& [code, text] : seen) s.values.push_back({code, text});
+  std::sort(s.values.begin(), s.values.end(), [](const EnumValue& a, const EnumValue& b) { return a.value < b.value; });
+}
+
+void Parser::bit_mask(const json& obj, const std::string& path, ProfileSignal& s) {
+  const bool has_bit = obj.contains("bit"), has_mask = obj.contains("mask");
+  if (!has_bit && !has_mask) return;
+  if (has_bit && has_mask) {
+    fail(path + "/mask", "give bit or mask, not both");
+    return;
+  }
+  const char* key = has_bit ? "bit" : "mask";
+  if (s.encoding.type != ValueType::u16) {
+    fail(path + "/" + key, "applies to a u16 register only, not " + std::string(name(s.encoding.type)));
+    return;
+  }
+  const auto v = has_bit ? integer_field(obj, path, "bit", 0, 15, true) : integer_field(obj, path, "mask", 1, 65535, true);
+  if (!v) return;
+  s.mask = static_cast<std::uint16_t>(has_bit ? (1u << *v) : static_cast<unsigned>(*v));
+  // The limits must fit the field, or part of the declared range could never be sent.
+  for (const auto& [k, limit] : {std::pair{"min", s.encoding.min}, std::pair{"max", s.encoding.max}})
+    if (std::isfinite(limit) && !encodable(s, limit))
+      fail(path + "/" + k, format_number(limit) + " does not fit the " + std::to_string(std::popcount(s.mask)) +
+                               " bit(s) of mask " + std::to_string(s.mask));
+}
+
+void Parser::otherwise(const SignalSpec& spec, const json& obj, const std::string& path, ProfileSignal& s) {
+  if (spec.labels.empty()) {
+    fail(path + "/otherwise", s.name + " is not an enumerated signal");
+    return;
+  }
+  const auto label = string_field(obj, path, "otherwise", false);
+  if (!label) return;
+  if (std::find(spec.labels.begin(), spec.labels.end(), *label) == spec.labels.end()) {
+    std::string known;
+    for (const std::string_view l : spec.labels) known += (known.empty() ? "" : ", ") + std::string(l);
+    fail(path + "/otherwise", "unknown label " + in_quotes(*label) + " for " + s.name + " (expected " + known + ")");
+    return;
+  }
+  s.otherwise = *label;
+}
+
+void Parser::reset_mode(const json& obj, const std::string& path, ProfileSignal& s) {
+  const auto it = obj.find("reset");
+  if (it == obj.end()) return;
+  const std::string rpath = path + "/reset";
+  if (!it->is_object()) {
+    fail(rpath, "must be an object: {\"mode\": \"pulse\", \"pulse_ms\": N} or {\"mode\": \"level\"}");
+    return;
+  }
+  reject_unknown(*it, rpath, {"mode", "pulse_ms"});
+  const auto mode = string_field(*it, rpath, "mode", true);
+  if (!mode) return;
+  if (*mode == "level") {
+    s.reset.mode = FaultResetMode::Mode::level;
+    if (it->contains("pulse_ms")) fail(rpath + "/pulse_ms", "applies to mode pulse only");
+  } else if (*mode == "pulse") {
+    s.reset.mode = FaultResetMode::Mode::pulse;
+    if (const auto ms = integer_field(*it, rpath, "pulse_ms", 1, 60'000, true))
+      s.reset.pulse_ms = static_cast<std::uint32_t>(*ms);
+  } else {
+    fail(rpath + "/mode", "unknown reset mode " + in_quotes(*mode) + " (expected pulse, level)");
+  }
+}
+
+bool Parser::encodable(const ProfileSignal& s, double value) {
+  if (s.masked()) {
+    std::uint16_t word = 0;
+    return !encode_field(s.encoding, s.mask, value, word);
+  }
+  std::uint16_t words[2];
+  return !encode_registers(s.encoding, value, words);
 }
 
 void Parser::heartbeat(const json& obj, const std::string& path, ProfileSignal& s) {
-  constexpr std::int64_t kMaxMs = 3'600'000;
   const auto period = integer_field(obj, path, "period_ms", 1, kMaxMs, true);
   const auto timeout = integer_field(obj, path, "timeout_ms", 1, kMaxMs, true);
   if (!period || !timeout) return;
@@ -340,7 +440,8 @@ void Parser::heartbeat(const json& obj, const std::string& path, ProfileSignal& 
   s.heartbeat = HeartbeatTiming{static_cast<std::uint32_t>(*period), static_cast<std::uint32_t>(*timeout)};
 }
 
-// Signals in one table of one unit id must not share an address.
+// Signals in one table of one unit id must not share an address, except masked signals on
+// disjoint bits of one register.
 void check_overlaps(Parser& p, const std::vector<ProfileSignal>& signals) {
   for (std::size_t i = 0; i < signals.size(); ++i) {
     for (std::size_t j = 0; j < i; ++j) {
@@ -348,6 +449,14 @@ void check_overlaps(Parser& p, const std::vector<ProfileSignal>& signals) {
       const ProfileSignal& b = signals[i];
       if (a.kind != b.kind || a.unit_id != b.unit_id) continue;
       if (b.address > a.last_address() || a.address > b.last_address()) continue;
+      if (a.masked() && b.masked()) {
+        if ((a.mask & b.mask) == 0) continue;
+        p.fail("/signals/" + json_pointer_token(b.name) + "/mask",
+               "shares bits " + std::to_string(a.mask & b.mask) + " of " + std::string(name(a.kind)) + " " +
+                   std::to_string(a.address) + " (unit id " + std::to_string(a.unit_id) + ") with " +
+                   in_quotes(a.name) + "; signals may share a register on disjoint bits only");
+        continue;
+      }
       p.fail("/signals/" + json_pointer_token(b.name) + "/address",
              "overlaps " + in_quotes(a.name) + " (" + std::string(name(a.kind)) + " " + std::to_string(a.address) +
                  ".." + std::to_string(a.last_address()) + ", unit id " + std::to_string(a.unit_id) + ")");
@@ -355,7 +464,80 @@ void check_overlaps(Parser& p, const std::vector<ProfileSignal>& signals) {
   }
 }
 
+// The top-level "watchdog", judged against the signals: a heartbeat signal is a counter watchdog;
+// without one a drive must say which watchdog it has, so no drive runs unguarded by omission.
+void parse_watchdog(Parser& p, const json& doc, DeviceProfile& profile) {
+  // Mapped, even if its mapping has mistakes of its own (reported at the signal).
+  const bool heartbeat = doc.at("signals").contains("heartbeat");
+  for (const ProfileSignal& s : profile.signals)
+    if (s.role == SignalRole::heartbeat && s.heartbeat)
+      profile.watchdog = {WatchdogKind::counter, "", s.heartbeat->period_ms, s.heartbeat->timeout_ms};
+
+  const auto it = doc.find("watchdog");
+  const bool drive = profile.kind != DeviceKind::vfc_meter;
+  if (it == doc.end()) {
+    if (drive && !heartbeat)
+      p.fail("/watchdog", "required when the profile maps no heartbeat signal: {\"kind\": \"any_write\", ...} or "
+                          "{\"kind\": \"none\"} (a drive without a watchdog must say so)");
+    return;
+  }
+  if (!it->is_object()) {
+    p.fail("/watchdog", "must be an object with kind counter, any_write or none");
+    return;
+  }
+  p.reject_unknown(*it, "/watchdog", {"kind", "refresh", "period_ms", "timeout_ms"});
+  const auto kind = p.enum_field<WatchdogKind>(
+      *it, "/watchdog", "kind", true,
+      [](std::string_view v) -> std::optional<WatchdogKind> {
+        for (std::size_t i = 0; i < kWatchdogNames.size(); ++i)
+          if (kWatchdogNames[i] == v) return static_cast<WatchdogKind>(i);
+        return std::nullopt;
+      },
+      "watchdog kind", "counter, any_write, none");
+  if (!kind) return;
+  if (*kind != WatchdogKind::any_write)
+    for (const char* key : {"refresh", "period_ms", "timeout_ms"})
+      if (it->contains(key))
+        p.fail(std::string("/watchdog/") + key,
+               *kind == WatchdogKind::counter ? "a counter's timing is on the heartbeat signal (period_ms, timeout_ms)"
+                                              : "applies to kind any_write only");
+  if (*kind == WatchdogKind::counter) {
+    if (!heartbeat) p.fail("/watchdog/kind", "counter needs a heartbeat signal (with period_ms and timeout_ms)");
+    return;
+  }
+  if (heartbeat) {
+    p.fail("/watchdog/kind", "the profile maps a heartbeat signal, which is a counter watchdog; " +
+                                 std::string(kWatchdogNames[static_cast<std::size_t>(*kind)]) +
+                                 " contradicts it (remove one)");
+    return;
+  }
+  if (*kind == WatchdogKind::none) {
+    profile.watchdog = WatchdogSpec{};
+    return;
+  }
+  const auto refresh = p.string_field(*it, "/watchdog", "refresh", true);
+  const auto period = p.integer_field(*it, "/watchdog", "period_ms", 1, kMaxMs, true);
+  const auto timeout = p.integer_field(*it, "/watchdog", "timeout_ms", 1, kMaxMs, true);
+  if (refresh) {
+    const ProfileSignal* s = profile.find(*refresh);
+    const SignalSpec* spec = find_signal_spec(profile.kind, *refresh);
+    if (!spec || spec->role != SignalRole::command)
+      p.fail("/watchdog/refresh", in_quotes(*refresh) + " is not a command signal of kind " +
+                                      std::string(name(profile.kind)));
+    else if (!s)
+      p.fail("/watchdog/refresh", in_quotes(*refresh) + " is not mapped by this profile");
+  }
+  if (period && timeout && *timeout <= *period)
+    p.fail("/watchdog/timeout_ms", "must exceed period_ms (" + std::to_string(*period) +
+                                       "), or every refresh arrives after the watchdog has tripped");
+  if (refresh && period && timeout)
+    profile.watchdog = {WatchdogKind::any_write, *refresh, static_cast<std::uint32_t>(*period),
+                        static_cast<std::uint32_t>(*timeout)};
+}
+
 }  // namespace
+
+std::string_view name(WatchdogKind k) { return kWatchdogNames[static_cast<std::size_t>(k)]; }
 
 std::string_view name(RegisterKind k) { return kRegisterKindNames[static_cast<std::size_t>(k)]; }
 std::string_view name(Access a) { return kAccessNames[static_cast<std::size_t>(a)]; }
@@ -398,7 +580,7 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
     return {std::nullopt, std::move(p.errors)};
   }
   p.reject_unknown(doc, "", {"name", "description", "kind", "unit_id", "word_order", "byte_order", "signals",
-                             "meter", "poll_period_ms", "time_base_Hz", "f0_Hz", "kf_Hz_per_A"});
+                             "watchdog", "meter", "poll_period_ms", "time_base_Hz", "f0_Hz", "kf_Hz_per_A"});
 
   DeviceProfile profile;
   profile.name = p.string_field(doc, "", "name", true).value_or("");
@@ -433,6 +615,7 @@ ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
       if (auto s = p.signal(*spec, value, path, defaults)) profile.signals.push_back(std::move(*s));
     }
     check_overlaps(p, profile.signals);
+    parse_watchdog(p, doc, profile);
     for (const SignalSpec& spec : signal_catalogue(*kind))
       if (spec.required && !signals->contains(spec.name))
         p.fail("/signals/" + json_pointer_token(spec.name),

@@ -36,11 +36,36 @@ struct HeartbeatTiming {
   std::uint32_t timeout_ms = 0;  // how long the device waits for a change before it trips
 };
 
+// How the bench resets a drive's latched fault through the fault_reset signal: level writes 1
+// (the device acts on the level and clears the register itself, as synbench's firmware does);
+// pulse writes 1, holds it pulse_ms and writes 0, for a device that resets on a rising edge.
+struct FaultResetMode {
+  enum class Mode { level, pulse };
+  Mode mode = Mode::level;
+  std::uint32_t pulse_ms = 0;  // pulse only
+};
+
+// What keeps a device's watchdog fed: counter (the bench writes a new heartbeat value every
+// period_ms), any_write (the bench rewrites the `refresh` command signal's last written value
+// every period_ms; the device trips when no write arrives for timeout_ms), none (the device has
+// no watchdog; only the bench's own supervisor stops it).
+enum class WatchdogKind { counter, any_write, none };
+std::string_view name(WatchdogKind k);
+
+struct WatchdogSpec {
+  WatchdogKind kind = WatchdogKind::none;
+  std::string refresh;           // any_write: the signal rewritten
+  std::uint32_t period_ms = 0;   // counter: the heartbeat's; any_write: the refresh period
+  std::uint32_t timeout_ms = 0;  // the device's timeout
+};
+
 // The device's number for one of the bench's labels of an enumerated signal (state,
-// estimator, ...): how a drive with its own codes is translated to the bench's.
+// estimator, ...): how a drive with its own codes is translated to the bench's. A label may
+// have several numbers; the first listed is the one the bench writes.
 struct EnumValue {
   std::int64_t value = 0;
   std::string label;
+  bool written = true;  // the label's first listed number: what the bench writes for it
 };
 
 struct ProfileSignal {
@@ -54,6 +79,13 @@ struct ProfileSignal {
   Access access = Access::r;
   std::vector<EnumValue> values;             // sorted by value; empty: the bench's own codes
   std::optional<HeartbeatTiming> heartbeat;  // set on the heartbeat signal only
+  // The bits of a u16 holding or input register the signal occupies ("bit" N is 1 << N); 0:
+  // the whole value. Signals on disjoint masks share a register.
+  std::uint16_t mask = 0;
+  std::string otherwise;        // enumerated: the label of any device number not in values
+  FaultResetMode reset;         // fault_reset only
+
+  bool masked() const { return mask != 0; }
 
   bool readable() const { return access != Access::w; }
   bool writable() const { return access != Access::r; }
@@ -81,6 +113,8 @@ struct DeviceProfile {
   std::optional<std::uint32_t> poll_period_ms;
   double time_base_Hz = 0;
   double f0_Hz = 0, kf_Hz_per_A = 0;
+  // Counter when a heartbeat signal is mapped; else as the profile says (a drive must say).
+  WatchdogSpec watchdog;
 
   const ProfileSignal* find(std::string_view signal) const;
 };

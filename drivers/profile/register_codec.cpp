@@ -147,6 +147,33 @@ std::error_code decode_registers(const RegisterEncoding& e, std::span<const std:
   return {};
 }
 
+std::uint16_t field_max(std::uint16_t mask) {
+  return mask == 0 ? 0 : static_cast<std::uint16_t>(mask >> std::countr_zero(mask));
+}
+
+std::error_code decode_field(const RegisterEncoding& e, std::uint16_t mask, std::uint16_t word, double& value) {
+  if (mask == 0 || e.type != ValueType::u16) return errc::invalid_argument;
+  const std::uint16_t w = e.byte_order == ByteOrder::big ? word : swap_bytes(word);
+  const auto field = static_cast<std::uint16_t>((w & mask) >> std::countr_zero(mask));
+  // The field is decoded as a u16 of its own: the word's byte order is already undone.
+  RegisterEncoding f = e;
+  f.byte_order = ByteOrder::big;
+  return decode_registers(f, std::span(&field, 1), value);
+}
+
+std::error_code encode_field(const RegisterEncoding& e, std::uint16_t mask, double value, std::uint16_t& word) {
+  if (mask == 0 || e.type != ValueType::u16) return errc::invalid_argument;
+  RegisterEncoding f = e;
+  f.byte_order = ByteOrder::big;
+  std::uint16_t field = 0;
+  if (auto ec = encode_registers(f, value, std::span(&field, 1))) return ec;
+  if (field > field_max(mask)) return errc::invalid_argument;
+  const std::uint16_t w = e.byte_order == ByteOrder::big ? word : swap_bytes(word);
+  const auto merged = static_cast<std::uint16_t>((w & ~mask) | ((field << std::countr_zero(mask)) & mask));
+  word = e.byte_order == ByteOrder::big ? merged : swap_bytes(merged);
+  return {};
+}
+
 std::error_code decode_bit(std::uint8_t raw, bool& on) {
   if (raw > 1) return errc::protocol;
   on = raw == 1;

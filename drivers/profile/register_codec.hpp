@@ -56,6 +56,16 @@ std::error_code encode_registers(const RegisterEncoding& e, double value, std::s
 std::error_code decode_registers(const RegisterEncoding& e, std::span<const std::uint16_t> words,
                                  double& value);
 
+// A field of one u16 register: the bits of `mask` (1..65535), read as (word & mask) >>
+// trailing_zeros(mask), so several signals can share a control or status word. The encoding's
+// type is u16 and its byte order applies to the whole word; scale, offset and limits to the field.
+std::uint16_t field_max(std::uint16_t mask);
+// errc::invalid_argument for a mask of 0 or a non-u16 encoding.
+std::error_code decode_field(const RegisterEncoding& e, std::uint16_t mask, std::uint16_t word, double& value);
+// Replaces the field's bits of `word` (other bits kept): errc::invalid_argument as
+// encode_registers, and when the raw value does not fit in the mask's width.
+std::error_code encode_field(const RegisterEncoding& e, std::uint16_t mask, double value, std::uint16_t& word);
+
 // A coil or discrete input as libmodbus carries it: one byte, 0 or 1.
 constexpr std::uint8_t encode_bit(bool on) { return on ? 1 : 0; }
 // errc::protocol for any byte other than 0 or 1; `on` is written only on success.

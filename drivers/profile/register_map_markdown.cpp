@@ -41,6 +41,7 @@ std::string limits(const RegisterEncoding& e) {
 }
 
 std::string address(const ProfileSignal& s) {
+  if (s.masked()) return std::to_string(s.address) + " mask " + std::to_string(s.mask);
   if (s.last_address() == s.address) return std::to_string(s.address);
   return std::to_string(s.address) + "-" + std::to_string(s.last_address());
 }
@@ -52,6 +53,8 @@ std::string notes(DeviceKind kind, const ProfileSignal& s) {
   if (const SignalSpec* spec = find_signal_spec(kind, s.name); spec && s.values.empty())
     for (std::size_t i = 0; i < spec->labels.size(); ++i)
       out += (i == 0 ? "" : ", ") + std::to_string(i) + " " + std::string(spec->labels[i]);
+  if (!s.otherwise.empty()) out += (out.empty() ? "" : ", ") + std::string("otherwise ") + s.otherwise;
+  if (s.reset.mode == FaultResetMode::Mode::pulse) out += "pulse of " + std::to_string(s.reset.pulse_ms) + " ms";
   if (s.heartbeat)
     out += "write every " + std::to_string(s.heartbeat->period_ms) + " ms; trips after " +
            std::to_string(s.heartbeat->timeout_ms) + " ms unchanged";

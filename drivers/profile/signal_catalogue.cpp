@@ -28,10 +28,10 @@ constexpr SignalSpec kSynrm[] = {
     {"pwm_scheme", R::command, false, "", "switching scheme", kPwmNames},
     {"estimator", R::command, false, "",
      "position source", kEstimatorNames},
-    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault"},
-    {"heartbeat", R::heartbeat, true, "",
+    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault (held pulse_ms with \"reset\": pulse)"},
+    {"heartbeat", R::heartbeat, false, "",
      "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
-     "has not changed for timeout_ms"},
+     "has not changed for timeout_ms (without it the profile names its \"watchdog\")"},
     {"window_start", R::window_start, false, "", "writing 1 opens a window of window_length_ms"},
     {"window_length_ms", R::window_length, false, "ms", "length of the next window"},
     {"state", R::telemetry, true, "", "drive state", kStateLabels},
@@ -78,10 +78,10 @@ constexpr SignalSpec kSynrm[] = {
 constexpr SignalSpec kLoad[] = {
     {"enable", R::command, true, "", "1 runs the drive, 0 disables it"},
     {"torque_setpoint_Nm", R::command, true, "Nm", "braking torque magnitude, applied against the rotation"},
-    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault"},
-    {"heartbeat", R::heartbeat, true, "",
+    {"fault_reset", R::fault_reset, true, "", "writing 1 clears a latched fault (held pulse_ms with \"reset\": pulse)"},
+    {"heartbeat", R::heartbeat, false, "",
      "the bench writes a new value every period_ms; the drive trips (fault 6 watchdog) when it "
-     "has not changed for timeout_ms"},
+     "has not changed for timeout_ms (without it the profile names its \"watchdog\")"},
     {"window_start", R::window_start, false, "",
      "writing 1 opens a window of window_length_ms; for a bench without a trigger line"},
     {"window_length_ms", R::window_length, false, "ms", "length of the next window"},

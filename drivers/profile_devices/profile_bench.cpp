@@ -48,19 +48,19 @@ BenchDevices ProfileBench::devices() { return {&synrm_, &load_, &meter_, &trigge
 Clock& ProfileBench::clock() { return *clock_; }
 
 void ProfileBench::tick(double now_s) {
-  // Host windows sample on their grid whether or not the heartbeats run.
+  // Host windows sample on their grid, and a reset pulse ends on time, also with the heartbeats
+  // stopped.
   trigger_.tick(now_s);
-  if (!heartbeats_) return;
-  synrm_.tick(now_s);
-  load_.tick(now_s);
-  meter_.tick(now_s);
+  synrm_.tick(now_s, heartbeats_);
+  load_.tick(now_s, heartbeats_);
+  meter_.tick(now_s, heartbeats_);
 }
 
 double ProfileBench::next_due_s() const { return std::min(next_heartbeat_s(), trigger_.next_due_s()); }
 
 double ProfileBench::next_heartbeat_s() const {
-  if (!heartbeats_) return std::numeric_limits<double>::infinity();
-  return std::min({synrm_.next_heartbeat_s(), load_.next_heartbeat_s(), meter_.next_heartbeat_s()});
+  return std::min({synrm_.next_heartbeat_s(heartbeats_), load_.next_heartbeat_s(heartbeats_),
+                   meter_.next_heartbeat_s(heartbeats_)});
 }
 
 }  // namespace synbench::drivers

@@ -37,8 +37,10 @@ class ProfileBench {
   // are stopped).
   void tick(double now_s);
   double next_heartbeat_s() const;
-  // The next heartbeat or host sample.
+  // The next heartbeat, reset pulse end or host sample.
   double next_due_s() const;
+  // Whether a drive's reset pulse is still held (tick() ends it).
+  bool resets_pending() const { return synrm_.reset_pending() || load_.reset_pending(); }
   // Stops or resumes the heartbeats: stopped, the drives' watchdogs stop the drives on their own.
   void set_heartbeats(bool on) { heartbeats_ = on; }
   bool heartbeats() const { return heartbeats_; }

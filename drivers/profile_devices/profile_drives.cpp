@@ -1,7 +1,9 @@
 // Typed devices over profile signals.
 #include "drivers/profile_devices/profile_drives.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "drivers/error.hpp"
@@ -9,15 +11,15 @@
 namespace synbench::drivers {
 namespace {
 
-const ProfileSignal* heartbeat_of(const DeviceProfile& p) {
-  for (const ProfileSignal& s : p.signals)
-    if (s.role == SignalRole::heartbeat) return &s;
-  return nullptr;
-}
-
 // NaN (signal absent from the profile) reads as `absent`.
 double or_(double v, double absent = 0.0) { return std::isnan(v) ? absent : v; }
 std::optional<double> opt(double v) { return std::isnan(v) ? std::nullopt : std::optional<double>(v); }
+
+// The device's own code behind a fault the profile has no label for.
+std::optional<std::int64_t> raw_code(Fault f, double device_value) {
+  if (f != Fault::unknown || std::isnan(device_value)) return std::nullopt;
+  return static_cast<std::int64_t>(device_value);
+}
 
 void require_kind(const DeviceProfile& p, DeviceKind kind) {
   if (p.kind != kind)
@@ -28,7 +30,43 @@ void require_kind(const DeviceProfile& p, DeviceKind kind) {
 }  // namespace
 
 ProfileDevice::ProfileDevice(RegisterBus& bus, DeviceProfile profile)
-    : profile_(std::move(profile)), io_(bus, profile_), heartbeat_(heartbeat_of(profile_)), window_(io_) {}
+    : profile_(std::move(profile)), io_(bus, profile_), heartbeat_(profile_), window_(io_) {}
+
+std::error_code ProfileDevice::pulse_fault_reset() {
+  const ProfileSignal* s = profile_.find("fault_reset");
+  auto ec = io_.write("fault_reset", 1);
+  if (!ec && s && s->reset.mode == FaultResetMode::Mode::pulse) {
+    // Held from the next tick on: logic never sleeps, the bench's clock ends the pulse.
+    reset_held_ = true;
+    reset_clear_s_ = std::numeric_limits<double>::quiet_NaN();
+  }
+  return ec;
+}
+
+std::error_code ProfileDevice::tick(double now_s, bool feed_watchdog) {
+  std::error_code ec;
+  if (reset_held_) {
+    const ProfileSignal* s = profile_.find("fault_reset");
+    if (std::isnan(reset_clear_s_)) reset_clear_s_ = now_s + s->reset.pulse_ms / 1000.0;
+    if (now_s >= reset_clear_s_ - 1e-9) {
+      ec = io_.write("fault_reset", 0);
+      if (!ec)
+        reset_held_ = false;
+      else
+        reset_clear_s_ = now_s + 0.01;  // tried again soon; a held reset blocks nothing else
+    }
+  }
+  if (feed_watchdog)
+    if (auto e = heartbeat_.tick(now_s, io_); e && !ec) ec = e;
+  return ec;
+}
+
+double ProfileDevice::next_heartbeat_s(bool feed_watchdog) const {
+  const double reset = !reset_held_ ? std::numeric_limits<double>::infinity()
+                       : std::isnan(reset_clear_s_) ? -std::numeric_limits<double>::infinity()
+                                                    : reset_clear_s_;
+  return std::min(reset, feed_watchdog ? heartbeat_.next_due_s() : std::numeric_limits<double>::infinity());
+}
 
 HostWindow* ProfileDevice::host_window_over(const ReadPlan& plan) {
   if (!profile_.poll_period_ms) return nullptr;
@@ -82,6 +120,7 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   if (auto ec = io().read(telemetry_, v)) return ec;
   out.state = static_cast<DriveState>(static_cast<int>(v[0]));
   out.fault = static_cast<Fault>(static_cast<int>(v[1]));
+  out.fault_code_raw = raw_code(out.fault, telemetry_.device_value(1));
   out.speed_rpm = v[2];
   out.im_A = or_(v[3]);
   out.id_A = or_(v[4]);
@@ -106,6 +145,7 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   SynrmWindow w;
   w.samples = static_cast<std::uint32_t>(v[2]);
   w.fault = static_cast<Fault>(static_cast<int>(or_(v[3])));
+  w.fault_code_raw = raw_code(w.fault, window_.device_value(3));
   w.window_s = v[4];
   w.speed_meas_rpm = or_(v[5]);
   w.im_A = or_(v[6]);
@@ -185,6 +225,7 @@ std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
   if (auto ec = io().read(telemetry_, v)) return ec;
   out.state = static_cast<DriveState>(static_cast<int>(v[0]));
   out.fault = static_cast<Fault>(static_cast<int>(v[1]));
+  out.fault_code_raw = raw_code(out.fault, telemetry_.device_value(1));
   out.torque_Nm = v[2];
   out.iq_A = or_(v[3]);
   return {};

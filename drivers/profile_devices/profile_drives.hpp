@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <system_error>
 
 #include "drivers/devices.hpp"
@@ -30,14 +31,19 @@ class ProfileDevice {
   WindowChannel& window() { return window_; }
   // What the trigger opens: the device's window channel, or the one set_window_source() gave.
   WindowSource& window_source() { return source_ ? *source_ : static_cast<WindowSource&>(window_); }
-  // Sends the heartbeat when due; errors are counted, the next tick retries.
-  std::error_code tick(double now_s) { return heartbeat_.tick(now_s, io_); }
-  double next_heartbeat_s() const { return heartbeat_.next_due_s(); }
+  // Sends the watchdog's refresh when due (unless `feed_watchdog` is false) and ends a reset
+  // pulse whose time is up; errors are counted, the next tick retries.
+  std::error_code tick(double now_s, bool feed_watchdog = true);
+  // When tick() has something to do next (the watchdog's refresh counted only when fed).
+  double next_heartbeat_s(bool feed_watchdog = true) const;
   std::uint64_t heartbeat_failures() const { return heartbeat_.failures(); }
+  bool reset_pending() const { return reset_held_; }
+  // What the last failed call ran into, in the device's terms (SignalIo::last_error).
+  std::string device_error() const { return io_.last_error(); }
 
  protected:
-  // Writes 1 to the fault-reset signal.
-  std::error_code pulse_fault_reset() { return io_.write("fault_reset", 1); }
+  // Writes 1 to the fault-reset signal; with a pulse reset the next ticks write 0 after pulse_ms.
+  std::error_code pulse_fault_reset();
   // A window kept other than by the device's window signals (host_window.hpp,
   // totalizer_window.hpp); the device's own constructor decides from its profile.
   void set_window_source(std::unique_ptr<WindowSource> source) { source_ = std::move(source); }
@@ -50,6 +56,9 @@ class ProfileDevice {
   Heartbeat heartbeat_;
   WindowChannel window_;
   std::unique_ptr<WindowSource> source_;
+  // A pulse reset's 1 is held: cleared at reset_clear_s_ (NaN: from the next tick's time).
+  bool reset_held_ = false;
+  double reset_clear_s_ = 0;
 };
 
 class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
@@ -67,6 +76,7 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   std::error_code reset_fault() override;
   std::error_code read(SynrmTelemetry& out) override;
   std::error_code read_window(SynrmWindow& out) override;
+  std::string error_detail() const override { return device_error(); }
 
  private:
   std::error_code read_host_window(SynrmWindow& out);
@@ -85,6 +95,7 @@ class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
   std::error_code reset_fault() override;
   std::error_code read(LoadTelemetry& out) override;
   std::error_code read_window(LoadWindow& out) override;
+  std::string error_detail() const override { return device_error(); }
 
  private:
   ReadPlan telemetry_, window_;
@@ -99,6 +110,7 @@ class ProfileMeter final : public PowerMeter, public ProfileDevice {
   std::error_code read(MeterReading& out) override;
   // The totalizer's window (meter totalizer), else null.
   const TotalizerWindow* totalizer() const { return totalizer_; }
+  std::string error_detail() const override { return device_error(); }
 
  private:
   ReadPlan gate_, power_;

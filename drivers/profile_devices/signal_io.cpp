@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <tuple>
 
 #include "drivers/error.hpp"
+#include "drivers/profile/number_format.hpp"
 #include "drivers/profile/signal_codes.hpp"
 
 namespace synbench::drivers {
@@ -72,6 +74,66 @@ std::error_code SignalIo::with_retries(bool idempotent, Request&& request) {
   return ec;
 }
 
+namespace {
+
+std::string hex_words(std::span<const std::uint16_t> words) {
+  std::string out;
+  char buf[8];
+  for (const std::uint16_t w : words) {
+    std::snprintf(buf, sizeof buf, "0x%04X", static_cast<unsigned>(w));
+    out += (out.empty() ? "" : " ") + std::string(buf);
+  }
+  return out;
+}
+
+std::string place(const ProfileSignal& s) {
+  std::string where = std::string(name(s.kind)) + " " + std::to_string(s.address);
+  if (s.last_address() != s.address) where += ".." + std::to_string(s.last_address());
+  if (s.masked()) where += " mask " + std::to_string(s.mask);
+  return where + ", unit id " + std::to_string(s.unit_id);
+}
+
+std::string limits_of(const RegisterEncoding& e) {
+  return "limits " + format_number(e.min) + ".." + format_number(e.max);
+}
+
+}  // namespace
+
+std::string SignalIo::device() const { return std::string(name(profile_.kind)) + " '" + profile_.name + "'"; }
+
+std::error_code SignalIo::fail(std::error_code ec, const ProfileSignal* s, std::string what) {
+  last_error_ = device() + (s ? ": signal " + s->name + " (" + place(*s) + ")" : std::string()) + ": " + what;
+  return ec;
+}
+
+std::error_code SignalIo::decode(const ProfileSignal& s, std::size_t at, double& bench_value, double& device_value) {
+  if (is_bit_kind(s.kind)) {
+    bool on = false;
+    if (auto ec = decode_bit(bits_[at], on))
+      return fail(ec, &s, "raw " + std::to_string(bits_[at]) + ": a bit reads 0 or 1");
+    device_value = on ? 1.0 : 0.0;
+  } else {
+    const auto words = std::span<const std::uint16_t>(words_).subspan(at, address_width(s.encoding.type));
+    RegisterEncoding e = s.encoding;
+    // A fault code is never out of range: a code the profile has no label for is a fault too.
+    if (is_fault_code(s)) {
+      e.min = -std::numeric_limits<double>::infinity();
+      e.max = std::numeric_limits<double>::infinity();
+    }
+    const auto ec = s.masked() ? decode_field(e, s.mask, words[0], device_value) : decode_registers(e, words, device_value);
+    if (ec)
+      return fail(ec, &s, "raw " + hex_words(words) + ": not a " + std::string(name(e.type)) + " within its " +
+                              limits_of(e) + " (scale " + format_number(e.scale) + ", offset " +
+                              format_number(e.offset) + ")");
+  }
+  if (auto ec = to_bench_code(profile_.kind, s, device_value, bench_value)) {
+    const std::size_t n = is_bit_kind(s.kind) ? 0 : address_width(s.encoding.type);
+    return fail(ec, &s, (n ? "raw " + hex_words(std::span<const std::uint16_t>(words_).subspan(at, n)) + ": " : "") +
+                            "device code " + format_number(device_value) + " has no label and no \"otherwise\"");
+  }
+  return {};
+}
+
 std::error_code SignalIo::read(const ReadPlan& plan, std::span<double> values) {
   if (values.size() < plan.size()) return make_error_code(errc::invalid_argument);
   words_.resize(plan.words_);
@@ -82,27 +144,45 @@ std::error_code SignalIo::read(const ReadPlan& plan, std::span<double> values) {
         return bus_.read_bits(r.unit_id, r.kind, r.address, std::span(bits_).subspan(r.buffer_offset, r.count));
       return bus_.read_registers(r.unit_id, r.kind, r.address, std::span(words_).subspan(r.buffer_offset, r.count));
     });
-    if (ec) return ec;
+    if (ec)
+      return fail(ec, nullptr,
+                  "reading " + std::string(name(r.kind)) + " " + std::to_string(r.address) + ".." +
+                      std::to_string(r.address + r.count - 1) + ", unit id " + std::to_string(r.unit_id) + ": " +
+                      bus_.last_error());
   }
+  device_values_.assign(plan.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const ReadPlan::Slot& slot = plan.slots_[i];
     if (!slot.signal) {
       values[i] = std::numeric_limits<double>::quiet_NaN();
       continue;
     }
-    const ProfileSignal& s = *slot.signal;
     const std::size_t at = plan.requests_[slot.request].buffer_offset + slot.offset;
-    double v = 0;
-    if (is_bit_kind(s.kind)) {
-      bool on = false;
-      if (auto ec = decode_bit(bits_[at], on)) return ec;
-      v = on ? 1.0 : 0.0;
-    } else {
-      if (auto ec = decode_registers(s.encoding, std::span(words_).subspan(at, address_width(s.encoding.type)), v))
-        return ec;
-    }
-    if (auto ec = to_bench_code(profile_.kind, s, v, values[i])) return ec;
+    if (auto ec = decode(*slot.signal, at, values[i], device_values_[i])) return ec;
   }
+  plan.device_values_ = device_values_;
+  last_error_.clear();
+  return {};
+}
+
+std::optional<double> SignalIo::last_written(std::string_view signal) const {
+  for (const auto& [n, v] : written_)
+    if (n == signal) return v;
+  return std::nullopt;
+}
+
+std::error_code SignalIo::write_masked(const ProfileSignal& s, double device_value, bool idempotent) {
+  // Read-modify-write by this, the device's only owner: the register's other bits are the
+  // device's own (or other signals'), kept as read.
+  std::uint16_t word = 0;
+  if (auto ec = with_retries(true, [&] { return bus_.read_registers(s.unit_id, s.kind, s.address, std::span(&word, 1)); }))
+    return fail(ec, &s, "reading the register to change its bits: " + bus_.last_error());
+  const std::uint16_t before = word;
+  if (auto ec = encode_field(s.encoding, s.mask, device_value, word))
+    return fail(ec, &s, format_number(device_value) + " does not fit its bits or " + limits_of(s.encoding));
+  if (auto ec = with_retries(idempotent, [&] { return bus_.write_registers(s.unit_id, s.address, std::span<const std::uint16_t>(&word, 1)); }))
+    return fail(ec, &s, "writing " + hex_words(std::span(&word, 1)) + " over " + hex_words(std::span(&before, 1)) + ": " +
+                            bus_.last_error());
   return {};
 }
 
@@ -110,19 +190,36 @@ std::error_code SignalIo::write(std::string_view signal, double value) {
   const ProfileSignal* s = profile_.find(signal);
   if (!s || !s->writable() || !is_writable_kind(s->kind)) return make_error_code(errc::not_supported);
   double device_value = 0;
-  if (auto ec = to_device_value(profile_.kind, *s, value, device_value)) return ec;
+  if (auto ec = to_device_value(profile_.kind, *s, value, device_value))
+    return fail(ec, s, "the device has no code for bench code " + format_number(value));
   const bool idempotent = s->role != SignalRole::window_start;
-  if (s->kind == RegisterKind::coil) {
-    if (device_value != 0 && device_value != 1) return make_error_code(errc::invalid_argument);
+  std::error_code ec;
+  if (s->masked()) {
+    ec = write_masked(*s, device_value, idempotent);
+  } else if (s->kind == RegisterKind::coil) {
+    if (device_value != 0 && device_value != 1)
+      return fail(make_error_code(errc::invalid_argument), s, format_number(device_value) + " is not a bit");
     const std::uint8_t bit = encode_bit(device_value != 0);
-    return with_retries(idempotent, [&] { return bus_.write_bits(s->unit_id, s->address, std::span(&bit, 1)); });
+    ec = with_retries(idempotent, [&] { return bus_.write_bits(s->unit_id, s->address, std::span(&bit, 1)); });
+    if (ec) fail(ec, s, "writing " + std::to_string(bit) + ": " + bus_.last_error());
+  } else {
+    std::uint16_t words[2];
+    const std::size_t n = address_width(s->encoding.type);
+    if ((ec = encode_registers(s->encoding, device_value, std::span(words, n))))
+      return fail(ec, s, format_number(device_value) + " is outside its " + limits_of(s->encoding) + " or type");
+    ec = with_retries(idempotent, [&] {
+      return bus_.write_registers(s->unit_id, s->address, std::span<const std::uint16_t>(words, n));
+    });
+    if (ec) fail(ec, s, "writing " + hex_words(std::span<const std::uint16_t>(words, n)) + ": " + bus_.last_error());
   }
-  std::uint16_t words[2];
-  const std::size_t n = address_width(s->encoding.type);
-  if (auto ec = encode_registers(s->encoding, device_value, std::span(words, n))) return ec;
-  return with_retries(idempotent, [&] {
-    return bus_.write_registers(s->unit_id, s->address, std::span<const std::uint16_t>(words, n));
-  });
+  if (ec) return ec;
+  last_error_.clear();
+  const auto it = std::find_if(written_.begin(), written_.end(), [&](const auto& w) { return w.first == s->name; });
+  if (it == written_.end())
+    written_.emplace_back(s->name, value);
+  else
+    it->second = value;
+  return {};
 }
 
 }  // namespace synbench::drivers

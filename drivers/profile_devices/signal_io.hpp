@@ -7,7 +7,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -29,6 +32,11 @@ class ReadPlan {
   std::size_t requests() const { return requests_.size(); }
   // Whether the profile maps the i-th name.
   bool present(std::size_t i) const { return slots_[i].signal != nullptr; }
+  // The device's own number of the i-th signal at the last successful read of this plan, before
+  // its enumerated label (NaN when absent or never read): the raw code of an unknown fault.
+  double device_value(std::size_t i) const {
+    return i < device_values_.size() ? device_values_[i] : std::numeric_limits<double>::quiet_NaN();
+  }
 
  private:
   friend class SignalIo;
@@ -49,6 +57,7 @@ class ReadPlan {
   std::vector<Request> requests_;
   std::vector<Slot> slots_;
   std::size_t words_ = 0;  // buffer sizes
+  mutable std::vector<double> device_values_;  // of the last successful read
 };
 
 class SignalIo {
@@ -77,15 +86,28 @@ class SignalIo {
 
   // Values of the plan's signals in engineering units, in the plan's order: bits as 0 or 1,
   // enumerated signals as the bench's codes, NaN for signals the profile does not map.
-  // On error `values` is unspecified.
+  // On error `values` is unspecified. A masked signal reads its bits of the register; a fault
+  // code is never out of range (a code without a label reads Fault::unknown).
   std::error_code read(const ReadPlan& plan, std::span<double> values);
-  // Encodes with the signal's limits (errc::invalid_argument outside them) and writes.
+  // Encodes with the signal's limits (errc::invalid_argument outside them) and writes. A masked
+  // signal is a read-modify-write of its register: the other signals' bits are kept.
   // errc::not_supported when the profile does not map the signal.
   std::error_code write(std::string_view signal, double value);
+  // The last value written to `signal` (bench units), if any.
+  std::optional<double> last_written(std::string_view signal) const;
+
+  // The last failure in the device's terms: device (kind and profile name), signal, table,
+  // address, unit id, raw word(s) in hex and the reason; empty when the last call succeeded.
+  const std::string& last_error() const { return last_error_; }
 
  private:
   template <class Request>
   std::error_code with_retries(bool idempotent, Request&& request);
+  // Decodes one signal of a completed read; on failure sets last_error_.
+  std::error_code decode(const ProfileSignal& s, std::size_t at, double& bench_value, double& device_value);
+  std::error_code write_masked(const ProfileSignal& s, double device_value, bool idempotent);
+  std::error_code fail(std::error_code ec, const ProfileSignal* s, std::string what);
+  std::string device() const;
 
   RegisterBus& bus_;
   const DeviceProfile& profile_;
@@ -94,6 +116,9 @@ class SignalIo {
   std::uint64_t repeats_ = 0;
   std::vector<std::uint16_t> words_;
   std::vector<std::uint8_t> bits_;
+  std::vector<double> device_values_;
+  std::vector<std::pair<std::string, double>> written_;
+  std::string last_error_;
 };
 
 }  // namespace synbench::drivers

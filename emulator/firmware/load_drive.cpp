@@ -92,7 +92,7 @@ void LoadDriveFirmware::begin_window(std::int64_t steps) {
 }
 
 drivers::LoadTelemetry LoadDriveFirmware::telemetry() const {
-  return {kt_ * f_iq_.value(), f_iq_.value(), state_, fault_};
+  return {kt_ * f_iq_.value(), f_iq_.value(), state_, fault_, std::nullopt};
 }
 
 }  // namespace synbench::emulator::firmware

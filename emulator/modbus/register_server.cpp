@@ -67,13 +67,25 @@ std::array<std::uint16_t, 2> RegisterServer::raw(Entry& e) {
   if (e.stuck && e.stuck_words) return *e.stuck_words;
   const drivers::ProfileSignal& s = *e.signal;
   std::array<std::uint16_t, 2> w{0, 0};
-  // Write-only signals (fault reset, window start) read as zero; the heartbeat reads back.
-  const bool pulse = s.role == drivers::SignalRole::fault_reset || s.role == drivers::SignalRole::window_start;
-  double v = pulse ? 0.0 : provider_.read_signal(e.device, s);
+  // Write-only signals (a level fault reset, window start) read as zero: the device clears
+  // them as it acts. A pulse reset's register holds what was written; the heartbeat reads back.
+  const bool self_clearing =
+      (s.role == drivers::SignalRole::fault_reset && s.reset.mode == drivers::FaultResetMode::Mode::level) ||
+      s.role == drivers::SignalRole::window_start;
+  double v = self_clearing ? 0.0 : provider_.read_signal(e.device, s);
   double device_value = 0;
-  if (drivers::to_device_value(e.device, s, v, device_value)) device_value = 0;
+  // A fault the profile has no code for is served as the bench's own number, never as "none":
+  // the bench then reads it as unknown (or the profile's otherwise).
+  if (drivers::to_device_value(e.device, s, v, device_value)) device_value = drivers::is_fault_code(s) ? v : 0;
   if (drivers::is_bit_kind(s.kind)) {
     w[0] = device_value != 0 ? 1 : 0;
+  } else if (s.masked()) {
+    if (!std::isfinite(device_value)) device_value = 0;
+    drivers::RegisterEncoding clamp = s.encoding;
+    // A field saturates at its bits, as a wider register at its type.
+    const double lo = clamp.offset, hi = drivers::field_max(s.mask) * clamp.scale + clamp.offset;
+    device_value = std::clamp(device_value, std::max(clamp.min, std::min(lo, hi)), std::min(clamp.max, std::max(lo, hi)));
+    if (drivers::encode_field(s.encoding, s.mask, device_value, w[0])) w[0] = 0;
   } else {
     // A real device saturates what it cannot represent; so does the twin.
     if (!std::isfinite(device_value)) device_value = 0;
@@ -107,7 +119,8 @@ std::uint8_t RegisterServer::read(std::uint8_t unit_id, RegisterKind kind, std::
       if (bits) {
         if (w[0]) data[k / 8] = static_cast<std::uint8_t>(data[k / 8] | (1u << (k % 8)));
       } else {
-        put16(&data[2 * k], w[i]);
+        // OR: masked signals of one register each contribute their bits.
+        put16(&data[2 * k], static_cast<std::uint16_t>(get16(&data[2 * k]) | w[i]));
       }
     }
   }
@@ -129,6 +142,29 @@ std::uint8_t RegisterServer::write_bits(std::uint8_t unit_id, std::uint16_t addr
   for (std::size_t i = 0; i < bits.size(); ++i)
     if (auto ec = provider_.write_signal(targets[i]->device, *targets[i]->signal, bits[i] ? 1.0 : 0.0))
       return exception_for(ec);
+  if (!targets.empty()) provider_.accepted_write(targets.front()->device);
+  return 0;
+}
+
+std::uint8_t RegisterServer::split_masked(std::vector<Entry*>& at, std::uint16_t word,
+                                          std::vector<std::pair<Entry*, double>>& writes) {
+  // Like a device acting on its control word: a signal whose bits did not change is not written
+  // again (a rewritten enable bit is no new enable; an edge-triggered reset needs an edge).
+  std::uint16_t current = 0;
+  for (Entry* e : at) current = static_cast<std::uint16_t>(current | raw(*e)[0]);
+  for (Entry* e : at) {
+    const drivers::ProfileSignal& s = *e->signal;
+    if (!s.writable()) continue;  // the device's own bits: a write does not change them
+    // The field's bits as they travel (the encoding may swap the word's bytes).
+    const auto wire_mask = s.encoding.byte_order == drivers::ByteOrder::big
+                               ? s.mask
+                               : static_cast<std::uint16_t>((s.mask >> 8) | (s.mask << 8));
+    if (((word ^ current) & wire_mask) == 0) continue;
+    double device_value = 0, code = 0;
+    if (drivers::decode_field(s.encoding, s.mask, word, device_value)) return kIllegalDataValue;
+    if (drivers::to_bench_code(e->device, s, device_value, code)) return kIllegalDataValue;
+    writes.emplace_back(e, code);
+  }
   return 0;
 }
 
@@ -139,12 +175,27 @@ std::uint8_t RegisterServer::write_words(std::uint8_t unit_id, std::uint16_t add
   // The request must cover whole writable signals, with nothing left over; check all of them
   // before applying any, so a refused value leaves the device unchanged.
   std::vector<std::pair<Entry*, double>> writes;
+  std::vector<Entry*> masked;
+  std::optional<drivers::DeviceKind> device;
   std::size_t i = 0;
   while (i < words.size()) {
     const auto it = std::find_if(t->begin(), t->end(), [&](const Entry& e) {
       return e.signal->address == address + i;
     });
-    if (it == t->end() || !it->signal->writable()) return kIllegalDataAddress;
+    if (it == t->end()) return kIllegalDataAddress;
+    device = it->device;
+    if (it->signal->masked()) {
+      // A shared register: its signals are the entries at this address, all masked (the
+      // profile refuses a mix); at least one of them must be writable.
+      masked.clear();
+      for (auto m = it; m != t->end() && m->signal->address == address + i; ++m) masked.push_back(&*m);
+      if (std::none_of(masked.begin(), masked.end(), [](const Entry* e) { return e->signal->writable(); }))
+        return kIllegalDataAddress;
+      if (const auto ex = split_masked(masked, words[i], writes)) return ex;
+      ++i;
+      continue;
+    }
+    if (!it->signal->writable()) return kIllegalDataAddress;
     const drivers::ProfileSignal& s = *it->signal;
     if (i + width(s) > words.size()) return kIllegalDataAddress;
     double device_value = 0, code = 0;
@@ -155,6 +206,7 @@ std::uint8_t RegisterServer::write_words(std::uint8_t unit_id, std::uint16_t add
   }
   for (auto& [e, v] : writes)
     if (auto ec = provider_.write_signal(e->device, *e->signal, v)) return exception_for(ec);
+  if (device) provider_.accepted_write(*device);
   return 0;
 }
 

@@ -51,8 +51,13 @@ class RegisterServer {
                     std::uint16_t count, std::span<std::uint8_t> data);
   std::uint8_t write_bits(std::uint8_t unit_id, std::uint16_t address, std::span<const std::uint8_t> bits);
   std::uint8_t write_words(std::uint8_t unit_id, std::uint16_t address, std::span<const std::uint16_t> words);
-  // The entry's current raw words (or bit in [0]), from the provider or frozen.
+  // The entry's current raw words (or bit in [0]), from the provider or frozen. A masked
+  // entry's word has only its own bits set: the register is the OR of its entries.
   std::array<std::uint16_t, 2> raw(Entry& e);
+  // The holding register's masked signals a write of `word` changes, as (entry, bench value);
+  // kIllegalDataValue when a changed field carries no valid value.
+  std::uint8_t split_masked(std::vector<Entry*>& at, std::uint16_t word,
+                            std::vector<std::pair<Entry*, double>>& writes);
 
   std::vector<drivers::DeviceProfile> profiles_;
   SignalProvider& provider_;

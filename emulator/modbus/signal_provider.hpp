@@ -20,6 +20,9 @@ class SignalProvider {
   // errc::invalid_argument or not_supported (answered ILLEGAL_DATA_VALUE), errc::busy
   // (SERVER_DEVICE_BUSY), anything else (SERVER_DEVICE_FAILURE).
   virtual std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) = 0;
+  // A write request to one of `device`'s registers was accepted, whether or not it changed a
+  // signal (a rewritten control word): what an any-write watchdog counts.
+  virtual void accepted_write(drivers::DeviceKind /*device*/) {}
 };
 
 }  // namespace synbench::emulator

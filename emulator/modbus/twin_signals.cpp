@@ -28,9 +28,25 @@ TwinSignals::TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& 
       f0_Hz_(twin.config().vfc.f0_Hz),
       kf_Hz_per_A_(twin.config().vfc.kf_Hz_per_A),
       instruments_(twin, profiles) {
-  for (const drivers::DeviceProfile& p : profiles)
-    for (const drivers::ProfileSignal& s : p.signals)
-      if (s.heartbeat) dev_[index(p.kind)].timeout_s = s.heartbeat->timeout_ms / 1000.0;
+  for (const drivers::DeviceProfile& p : profiles) {
+    Device& d = dev_[index(p.kind)];
+    d.watchdog = p.watchdog.kind;
+    if (p.watchdog.kind != drivers::WatchdogKind::none) d.timeout_s = p.watchdog.timeout_ms / 1000.0;
+    if (const drivers::ProfileSignal* r = p.find("fault_reset"))
+      d.reset_on_edge = r->reset.mode == drivers::FaultResetMode::Mode::pulse;
+  }
+}
+
+void TwinSignals::accepted_write(DeviceKind device) {
+  Device& d = dev_[index(device)];
+  if (d.watchdog == drivers::WatchdogKind::any_write) d.heartbeat_change_s = twin_.time_s();
+}
+
+bool TwinSignals::reset_requested(Device& d, double v) {
+  if (!d.reset_on_edge) return v != 0;
+  const bool rising = v != 0 && d.reset_level == 0;
+  d.reset_level = v;
+  return rising;
 }
 
 bool TwinSignals::drive_enabled(DeviceKind k) const {
@@ -45,6 +61,7 @@ double TwinSignals::synrm_value(const std::string& n) const {
   const Device& d = dev_[index(DeviceKind::synrm_drive)];
   if (n == "enable") return fw.state() == DriveState::running || fw.state() == DriveState::stopping;
   if (n == "heartbeat") return d.heartbeat;
+  if (n == "fault_reset") return d.reset_level;
   if (n == "window_length_ms") return d.window_length_ms;
   if (n == "speed_setpoint_rpm") return speed_set_rpm_;
   if (n == "angle_setpoint_deg") return angle_set_deg_;
@@ -102,6 +119,7 @@ double TwinSignals::load_value(const std::string& n) const {
   const drivers::LoadTelemetry t = twin_.load_drive().telemetry();
   if (n == "enable") return t.state == DriveState::running || t.state == DriveState::stopping;
   if (n == "heartbeat") return d.heartbeat;
+  if (n == "fault_reset") return d.reset_level;
   if (n == "window_length_ms") return d.window_length_ms;
   if (n == "torque_setpoint_Nm") return torque_set_Nm_;
   if (n == "state") return code(t.state);
@@ -207,7 +225,7 @@ std::error_code TwinSignals::write_signal(DeviceKind device, const drivers::Prof
         if (!ec && v != 0) d.heartbeat_change_s = now;  // the watchdog counts from the enable
         return ec;
       }
-      if (n == "fault_reset") return v != 0 ? synrm.reset_fault() : std::error_code{};
+      if (n == "fault_reset") return reset_requested(d, v) ? synrm.reset_fault() : std::error_code{};
       if (n == "speed_setpoint_rpm") {
         const auto ec = synrm.set_speed_rpm(v);
         if (!ec) speed_set_rpm_ = v;
@@ -232,7 +250,7 @@ std::error_code TwinSignals::write_signal(DeviceKind device, const drivers::Prof
         if (!ec && v != 0) d.heartbeat_change_s = now;
         return ec;
       }
-      if (n == "fault_reset") return v != 0 ? load.reset_fault() : std::error_code{};
+      if (n == "fault_reset") return reset_requested(d, v) ? load.reset_fault() : std::error_code{};
       if (n == "torque_setpoint_Nm") {
         const auto ec = load.set_torque_Nm(v);
         if (!ec) torque_set_Nm_ = v;

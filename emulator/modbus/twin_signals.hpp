@@ -1,7 +1,9 @@
 // The firmware side of the twin's register map: what each signal of the default profiles means
-// on the twin's drives and meter, plus what a drive does around its registers: the watchdog
-// (the heartbeat must change within timeout_ms while a drive is enabled, else both drives stop
-// in order and latch fault 6), the fault reset, and the measurement windows with their status
+// on the twin's drives and meter, plus what a drive does around its registers: the watchdog the
+// profile names (counter: the heartbeat must change within timeout_ms while a drive is enabled;
+// any_write: some write must arrive within it; else both drives stop in order and latch fault 6;
+// none: no timer), the fault reset (on the level, or with a pulse-reset profile only on a rising
+// edge, as a drive that wants a pulse does), and the measurement windows with their status
 // and sequence numbers. The three devices share one trigger, as on the thesis bench: the first
 // window start opens the twin's window on all of them, a start on another device while it is
 // open joins it (same length), and each participant's results are published when it closes.
@@ -26,6 +28,8 @@ class TwinSignals final : public SignalProvider {
 
   double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) override;
   std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) override;
+  // With an any_write watchdog every accepted write restarts the device's timeout.
+  void accepted_write(drivers::DeviceKind device) override;
 
   // Runs the twin `steps` periods, checking the watchdogs and the window every millisecond.
   void advance(std::int64_t steps);
@@ -50,12 +54,19 @@ class TwinSignals final : public SignalProvider {
     double heartbeat = 0;
     double heartbeat_change_s = 0;
     double timeout_s = 0;  // 0: no watchdog
+    drivers::WatchdogKind watchdog = drivers::WatchdogKind::none;
+    // A pulse-reset profile: the firmware resets on a rising edge of fault_reset only, and the
+    // register holds the level written.
+    bool reset_on_edge = false;
+    double reset_level = 0;
     double window_length_ms = 1000;
     bool in_window = false;
     WindowState window;
   };
   static std::size_t index(drivers::DeviceKind k) { return static_cast<std::size_t>(k); }
   bool drive_enabled(drivers::DeviceKind k) const;
+  // Whether a write of `v` to fault_reset resets the drive (and keeps the level it leaves).
+  bool reset_requested(Device& d, double v);
   void check_watchdogs();
   void close_window();
   std::error_code start_window(drivers::DeviceKind k);

@@ -140,10 +140,14 @@ int bench_command(const std::vector<std::string>& argv) {
     std::cerr << "synbench bench: clearing the faults failed: " << ec.message() << "\n" << backend->link_errors();
     return 1;
   }
-  // Read back after a period, so the drives have acted on it.
-  t += tick_s;
-  backend->clock().wait_until(t);
-  backend->tick(t);
+  // Read back after a period, so the drives have acted on it, and after any reset pulse ended
+  // (its hold is at most 60 s).
+  const double pulse_deadline_s = t + 61.0;
+  do {
+    t += tick_s;
+    backend->clock().wait_until(t);
+    backend->tick(t);
+  } while (backend->ticks_pending() && t < pulse_deadline_s);
   supervisor.tick(t);
   print(drives_json(supervisor), json);
   if (!readable(supervisor) || faulted(supervisor)) {

@@ -75,6 +75,12 @@ std::string ConfiguredBench::link_errors() const {
   std::string s;
   for (const auto& [name, bus] : buses_)
     if (!bus->last_error().empty()) s += "  " + bus->last_error() + "\n";
+  // A reply that arrived but could not be read as the profile says: signal, register, raw words.
+  if (bench_)
+    for (const drivers::ProfileDevice* d : {static_cast<const drivers::ProfileDevice*>(&bench_->synrm()),
+                                            static_cast<const drivers::ProfileDevice*>(&bench_->load()),
+                                            static_cast<const drivers::ProfileDevice*>(&bench_->meter())})
+      if (!d->device_error().empty()) s += "  " + d->device_error() + "\n";
   return s;
 }
 
@@ -137,6 +143,7 @@ class ConfiguredBackend final : public app::BenchBackend {
   drivers::BenchDevices devices() override { return bench_.bench().devices(); }
   drivers::Clock& clock() override { return bench_.bench().clock(); }
   void tick(double now_s) override { bench_.bench().tick(now_s); }
+  bool ticks_pending() const override { return bench_.bench().resets_pending(); }
   void set_heartbeats(bool on) override { bench_.bench().set_heartbeats(on); }
   bool heartbeats() const override { return bench_.bench().heartbeats(); }
   nlohmann::json describe() const override { return bench_.describe_devices(); }

@@ -168,6 +168,7 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
+    raw.exec("ALTER TABLE points DROP COLUMN fault_code_raw");
     raw.exec("ALTER TABLE points DROP COLUMN lock_lost");
     raw.exec("ALTER TABLE points DROP COLUMN fallback_fraction");
     raw.exec("ALTER TABLE points DROP COLUMN below_min_speed");
@@ -206,6 +207,7 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_host");
+    raw.exec("ALTER TABLE points DROP COLUMN fault_code_raw");
     raw.exec("PRAGMA user_version = 3");
   }
   auto store = Store::open(path);
@@ -268,7 +270,7 @@ TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
   const auto path = dir / "schema.db";
   { ASSERT_TRUE(Store::open(path)); }
   // Version 1's columns, then those later migrations added (ALTER TABLE appends them).
-  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "window_source"};
+  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "window_source", "fault_code_raw"};
   const auto n_added = static_cast<std::ptrdiff_t>(added.size());
   ASSERT_EQ(std::vector<std::string>(record_fields.end() - n_added, record_fields.end()), added);
   std::vector<std::string> expected{"id", "sweep_id", "point_index"};

@@ -62,6 +62,10 @@ inline bench::PointRecord sample_record(std::int64_t i) {
   r.fallback_fraction = r.below_min_speed ? 1.0 - 1.0 / (3.0 + x) : 0.0;
   r.lock_lost = i % 7 == 4;
   if (i % 5 == 3) r.fault = i % 10 == 3 ? "overcurrent" : "link_loss, \"quoted\"";  // CSV quoting
+  if (i % 10 == 9) {
+    r.fault = "unknown";  // a device code without a label, kept as the device sent it
+    r.fault_code_raw = i == 9 ? 4'294'967'295 : 0x2310 + i;
+  }
   if (i % 3 != 0) {
     drivers::TruthWindow t;
     t.pin_W = 300.0 + x / 3.0;

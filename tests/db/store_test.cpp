@@ -173,6 +173,10 @@ TEST_F(StoreTest, EveryFieldRoundTripsExactly) {
   EXPECT_EQ(std::bit_cast<std::uint64_t>((*rows)[1].record.truth->pmech_W), std::bit_cast<std::uint64_t>(1.5e-310));
   EXPECT_EQ((*rows)[8].record.fault, "link_loss, \"quoted\"");
   EXPECT_EQ((*rows)[13].record.fault, "overcurrent");
+  EXPECT_EQ((*rows)[19].record.fault, "unknown");
+  EXPECT_EQ((*rows)[19].record.fault_code_raw, 0x2310 + 19);
+  EXPECT_EQ((*rows)[9].record.fault_code_raw, 4'294'967'295);
+  EXPECT_FALSE((*rows)[13].record.fault_code_raw);
 }
 
 TEST_F(StoreTest, NanInARequiredFieldComesBackAsNan) {

@@ -109,8 +109,8 @@ const std::vector<InvalidCase> kInvalid = {
      "/signals/gate_s/unit", "must be 's'"},
     {"missing_required_signal", DeviceKind::vfc_meter, [](json& d) { d["signals"].erase("counts_g"); },
      "/signals/counts_g", "required for meter gate"},
-    {"missing_required_heartbeat", DeviceKind::load_drive, [](json& d) { d["signals"].erase("heartbeat"); },
-     "/signals/heartbeat", "required signal of kind load_drive is missing"},
+    {"drive_without_heartbeat_or_watchdog", DeviceKind::load_drive, [](json& d) { d["signals"].erase("heartbeat"); },
+     "/watchdog", "required when the profile maps no heartbeat signal"},
     {"unknown_signal", DeviceKind::vfc_meter,
      [](json& d) { d["signals"]["speed_rpm"] = d["signals"]["gate_s"]; }, "/signals/speed_rpm",
      "unknown signal for kind vfc_meter"},
@@ -148,7 +148,7 @@ const std::vector<InvalidCase> kInvalid = {
      "gate_sequence is not an enumerated signal"},
     {"enum_value_twice", DeviceKind::vfc_meter,
      [](json& d) { d["signals"]["gate_status"]["values"]["open"] = 2; }, "/signals/gate_status/values/open",
-     "also the value of 'done'"},
+     "also a code of 'done'"},
     {"enum_on_a_float", DeviceKind::vfc_meter,
      [](json& d) {
        d["signals"]["gate_status"]["type"] = "f32";

@@ -23,8 +23,12 @@ inline std::vector<drivers::DeviceProfile> default_profiles() {
 
 struct Emulator {
   explicit Emulator(const emulator::FaultPlan& plan = {}, double time_scale = 1.0)
-      : profiles(default_profiles()), service(emulator::TwinConfig{}, profiles), faults(plan),
-        tcp(service, faults), rtu(service, faults) {
+      : Emulator(default_profiles(), plan, time_scale) {}
+  // The twin served through other profiles (one of each kind).
+  explicit Emulator(std::vector<drivers::DeviceProfile> served, const emulator::FaultPlan& plan = {},
+                    double time_scale = 1.0)
+      : profiles(std::move(served)), service(emulator::TwinConfig{}, profiles), faults(plan), tcp(service, faults),
+        rtu(service, faults) {
     service.start_realtime(time_scale);
   }
   ~Emulator() {

@@ -3,13 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "drivers/error.hpp"
 #include "drivers/profile_devices/profile_bench.hpp"
+#include "tests/drivers/profile/vendor_profiles.hpp"
 #include "tests/drivers/profile_devices/fake_bus.hpp"
 
 namespace synbench::drivers {
 namespace {
+
+using nlohmann::json;
 
 using testing::FakeBus;
 
@@ -303,6 +307,124 @@ TEST_F(WindowFixture, TheClockSendsHeartbeatsWhileTheBenchWaits) {
   EXPECT_LE(drive1, 11);
   EXPECT_EQ(drive2, drive1);
   EXPECT_EQ(meter, 0);
+}
+
+// --- Decode errors, bits, unknown faults, reset pulses, any-write refresh ---------------------
+
+TEST(ProfileSynrmDrive, DecodeErrorsNameDeviceSignalRegisterAndRawWords) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, load_default(DeviceKind::synrm_drive));
+  bus.set(*drive.profile().find("state"), 7);  // limits 0..3
+  SynrmTelemetry t;
+  EXPECT_EQ(drive.read(t), errc::protocol);
+  EXPECT_EQ(drive.error_detail(),
+            "synrm_drive 'synbench SynRM drive': signal state (input 0, unit id 1): raw 0x0007: not a u16 within "
+            "its limits 0..3 (scale 1, offset 0)");
+  bus.set(*drive.profile().find("state"), 1);
+  bus.at(1, RegisterKind::input, 16) = 0x7FC0;  // f32 NaN
+  bus.at(1, RegisterKind::input, 17) = 0x0000;
+  EXPECT_EQ(drive.read(t), errc::protocol);
+  EXPECT_NE(drive.error_detail().find("signal speed_rpm (input 16..17, unit id 1): raw 0x7FC0 0x0000"), std::string::npos)
+      << drive.error_detail();
+  bus.at(1, RegisterKind::input, 16) = 0;
+  ASSERT_FALSE(drive.read(t));
+  EXPECT_EQ(drive.error_detail(), "");  // a success clears it
+  bus.fail_next = make_error_code(errc::timeout);
+  EXPECT_EQ(drive.read(t), errc::timeout);
+  EXPECT_NE(drive.error_detail().find("reading discrete_input 0..1, unit id 1"), std::string::npos) << drive.error_detail();
+}
+
+TEST(ProfileSynrmDrive, StateFromStatusBitsAndFaultsWithoutALabel) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(
+      bus, synbench::testing::parse_or_throw(synbench::testing::vendor_synrm(synbench::testing::pulse_reset(),
+                                                                              json(), /*watchdog_code=*/false)));
+  SynrmTelemetry t;
+  bus.at(1, RegisterKind::input, 40) = 0xFFF3;  // bits 0, 1 of mask 0x000B: 3, running; the rest ignored
+  ASSERT_FALSE(drive.read(t)) << drive.error_detail();
+  EXPECT_EQ(t.state, DriveState::running);
+  EXPECT_EQ(t.fault, Fault::none);
+  EXPECT_FALSE(t.fault_code_raw);
+  bus.at(1, RegisterKind::input, 40) = 0x0009;  // 9: faulted
+  bus.at(1, RegisterKind::input, 41) = 0x2311;  // the second code of overcurrent
+  ASSERT_FALSE(drive.read(t));
+  EXPECT_EQ(t.state, DriveState::faulted);
+  EXPECT_EQ(t.fault, Fault::overcurrent);
+  bus.at(1, RegisterKind::input, 41) = 0x8130;  // the watchdog, which this profile does not list
+  ASSERT_FALSE(drive.read(t)) << drive.error_detail();
+  EXPECT_EQ(t.fault, Fault::unknown);
+  EXPECT_EQ(t.fault_code_raw, 0x8130);
+  // The default profile's fault code is limited to 0..9; a 12 is a fault all the same.
+  FakeBus own_bus;
+  ProfileSynrmDrive own(own_bus, load_default(DeviceKind::synrm_drive));
+  own_bus.set(*own.profile().find("fault_code"), 12);
+  ASSERT_FALSE(own.read(t)) << own.error_detail();
+  EXPECT_EQ(t.fault, Fault::unknown);
+  EXPECT_EQ(t.fault_code_raw, 12);
+}
+
+TEST(ProfileSynrmDrive, AStateCodeWithoutALabelIsAnErrorThatSaysSo) {
+  json doc = synbench::testing::vendor_synrm(synbench::testing::pulse_reset(), json());
+  doc["signals"]["state"].erase("otherwise");
+  doc["signals"]["state"]["values"].erase("stopping");
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, synbench::testing::parse_or_throw(doc));
+  bus.at(1, RegisterKind::input, 40) = 0x0006;  // bit 2 is not the state's: 2 under mask 0x000B
+  SynrmTelemetry t;
+  EXPECT_EQ(drive.read(t), errc::protocol);
+  EXPECT_EQ(drive.error_detail(),
+            "synrm_drive 'vendor SynRM drive': signal state (input 40 mask 11, unit id 1): raw 0x0006: device code 2 "
+            "has no label and no \"otherwise\"");
+}
+
+TEST(ProfileSynrmDrive, APulseResetIsClearedFromTheTickAndKeepsTheOtherBits) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, synbench::testing::parse_or_throw(synbench::testing::vendor_synrm(
+                                   synbench::testing::pulse_reset(100), synbench::testing::no_watchdog())));
+  ASSERT_FALSE(drive.io().write("enable", 1));
+  bus.at(1, RegisterKind::holding, 40) |= 0x0100;  // a bit the profile does not map stays as the device has it
+  EXPECT_EQ(drive.next_heartbeat_s(), std::numeric_limits<double>::infinity());
+  ASSERT_FALSE(drive.reset_fault());
+  EXPECT_EQ(bus.at(1, RegisterKind::holding, 40), 0x0181);
+  ASSERT_FALSE(drive.tick(10.0));  // the hold starts at the first tick
+  EXPECT_DOUBLE_EQ(drive.next_heartbeat_s(), 10.1);
+  ASSERT_FALSE(drive.tick(10.05));
+  EXPECT_EQ(bus.at(1, RegisterKind::holding, 40), 0x0181);
+  ASSERT_FALSE(drive.tick(10.1));
+  EXPECT_EQ(bus.at(1, RegisterKind::holding, 40), 0x0101);
+  EXPECT_EQ(drive.next_heartbeat_s(), std::numeric_limits<double>::infinity());
+  // A level reset writes 1 and nothing after.
+  FakeBus level_bus;
+  ProfileSynrmDrive level(level_bus, synbench::testing::parse_or_throw(synbench::testing::vendor_synrm(
+                                         synbench::testing::level_reset(), synbench::testing::no_watchdog())));
+  ASSERT_FALSE(level.reset_fault());
+  ASSERT_FALSE(level.tick(20.0));
+  ASSERT_FALSE(level.tick(30.0));
+  EXPECT_EQ(level_bus.at(1, RegisterKind::holding, 40), 0x0080);
+}
+
+TEST(Heartbeat, AnAnyWriteWatchdogRewritesTheLastValueOnceThereIsOne) {
+  FakeBus bus;
+  ProfileSynrmDrive drive(bus, synbench::testing::parse_or_throw(synbench::testing::vendor_synrm(
+                                   synbench::testing::pulse_reset(), synbench::testing::any_write("speed_setpoint_rpm", 250, 1000))));
+  ASSERT_FALSE(drive.tick(0.0));
+  EXPECT_TRUE(bus.log.empty()) << "nothing to refresh before the first write";
+  ASSERT_FALSE(drive.set_speed_rpm(700));
+  bus.log.clear();
+  bus.at(1, RegisterKind::holding, 16) = 0;  // so the rewrite shows
+  ASSERT_FALSE(drive.tick(0.3));
+  ASSERT_EQ(bus.log.size(), 1u);
+  EXPECT_EQ(bus.log[0].op, "write");
+  EXPECT_EQ(bus.log[0].address, 16);
+  double v = 0;
+  const std::uint16_t w[2] = {bus.at(1, RegisterKind::holding, 16), bus.at(1, RegisterKind::holding, 17)};
+  ASSERT_FALSE(decode_registers(drive.profile().find("speed_setpoint_rpm")->encoding, w, v));
+  EXPECT_EQ(v, 700);
+  EXPECT_DOUBLE_EQ(drive.next_heartbeat_s(), 0.55);
+  ASSERT_FALSE(drive.tick(0.5));
+  EXPECT_EQ(bus.log.size(), 1u);
+  ASSERT_FALSE(drive.tick(0.55));
+  EXPECT_EQ(bus.log.size(), 2u);
 }
 
 }  // namespace
