@@ -28,7 +28,7 @@ struct RecordColumn {
   Member member;
 };
 
-inline const std::array<RecordColumn, 39> kRecordColumns{{
+inline const std::array<RecordColumn, 40> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
