@@ -48,6 +48,7 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
 import far_side as fs  # noqa: E402
+from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
 
 SPEED, LOAD_NM, ANGLE = 600.0, 0.5, 50.0
 WATCHDOG_MS = 3000     # the emulator's: a loaded machine may stall the daemon a fraction of a second
@@ -83,9 +84,9 @@ class Bench:
         self.far = fs.ModbusTcp(self.emu.port)
         link = fs.rtu_link(self.pair.b) if self.pair else fs.tcp_link(self.emu.port)
         cfg = fs.write_bench_config(os.path.join(tmp, kind + "_bench.json"), link)
-        self.serve = fs.Serve(binary, cfg, os.path.join(tmp, kind + "_data"), os.path.join(tmp, kind + "_serve.log"),
-                              start_timeout_s=SLOW_S)
-        self.viewer = self.serve.new_token("viewer")
+        self.serve = Daemon(binary, os.path.join(tmp, kind + "_data"), ["--bench", cfg],
+                            log_path=os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
+        self.viewer = self.serve.token("viewer")
         self.latched = False  # an E-stop was sent since the last successful reset
         status, body = self.serve.request("POST", "/api/bench/setpoints",
                                           {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
@@ -93,7 +94,7 @@ class Bench:
             print("  %s: setpoints -> %s %s" % (kind, status, str(body)[:200]))
 
     def close(self):
-        rc = self.serve.stop()
+        rc, _ = self.serve.stop()
         self.far.close()
         self.emu.stop()
         if self.pair:
@@ -117,7 +118,7 @@ class Bench:
             if status != 200:
                 raise TrialError("reset -> %s %s" % (status, str(body)[:160]))
             self.latched = False
-        if not fs.wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
+        if not wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
             raise TrialError("drives not disabled and clear before the trial: %s" % fs.describe(self.far.states()))
         sid = None
         if condition == "sweep":
@@ -132,10 +133,10 @@ class Bench:
             status, body = self.serve.request("POST", "/api/bench/enable", {"enabled": True})
             if status != 200:
                 raise TrialError("enable -> %s %s" % (status, str(body)[:160]))
-        if not fs.wait_for(self.running, SLOW_S, 0.02):
+        if not wait_for(self.running, SLOW_S, 0.02):
             raise TrialError("not at speed: %s, %.0f rpm" % (fs.describe(self.far.states()), self.far.speed_rpm()))
         time.sleep(random.uniform(0, 0.05))
-        pending = fs.PendingRequest(self.serve.port, self.serve.raw_request_bytes("POST", "/api/bench/estop"))
+        pending = PendingRequest(self.serve.port, self.serve.raw_request_bytes("POST", "/api/bench/estop"))
         self.latched = True
         latency = None
         while True:
@@ -153,7 +154,7 @@ class Bench:
                              % (GIVE_UP_S, fs.describe(states), pending.status))
         if pending.status != 200:
             raise TrialError("E-stop -> %s %s" % (pending.status, pending.body[:160] if pending.body else ""))
-        if sid is not None and not fs.wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
+        if sid is not None and not wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
             raise TrialError("sweep %d still running after the E-stop" % sid)
         return latency, pending.answered_at - pending.sent_at
 

@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
-from ws_util import Daemon  # noqa: E402
+from daemon import Daemon  # noqa: E402
 
 
 def arg(name, default):

@@ -16,7 +16,8 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
-from ws_util import Daemon, connect, recv_until  # noqa: E402
+from daemon import Daemon  # noqa: E402
+from ws_util import connect, recv_until  # noqa: E402
 
 
 def arg(name, default):
