@@ -49,6 +49,7 @@ import urllib.request
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
 import far_side as fs  # noqa: E402
 from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
+from script_args import flag, option  # noqa: E402
 
 SPEED, LOAD_NM, ANGLE = 600.0, 0.5, 50.0
 WATCHDOG_MS = 3000     # the emulator's: a loaded machine may stall the daemon a fraction of a second
@@ -58,10 +59,6 @@ TARGET_MS = {"tcp": 50.0, "rtu": 100.0}
 LOCAL = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # loopback: never through a proxy
 PLAN = {"name": "estop latency", "window_s": 1.0,
         "dimensions": {"speed_rpm": [SPEED], "load_Nm": [LOAD_NM], "angle_deg": [46, 50, 54, 58]}}
-
-
-def arg(name, default):
-    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
 
 
 class TrialError(Exception):
@@ -317,13 +314,13 @@ def main():
             print("SKIP: %s is not installed (scripts/debian-packages.txt)" % tool)
             sys.exit(77)
     binary = sys.argv[1]
-    smoke = "--smoke" in sys.argv
-    trials = arg("--trials", 3 if smoke else 50)
-    links = arg("--links", "tcp,rtu").split(",")
-    conditions = arg("--conditions", "idle,sweep,polled").split(",")
-    connections = arg("--connections", 4 if smoke else 50)
-    threads = arg("--threads", 2)
-    seconds = arg("--seconds", 1 if smoke else 10)
+    smoke = flag("--smoke")
+    trials = option("--trials", 3 if smoke else 50)
+    links = option("--links", "tcp,rtu").split(",")
+    conditions = option("--conditions", "idle,sweep,polled").split(",")
+    connections = option("--connections", 4 if smoke else 50)
+    threads = option("--threads", 2)
+    seconds = option("--seconds", 1 if smoke else 10)
     random.seed(1)
     tmp = tempfile.mkdtemp(prefix="synbench_estop_bench_")
     rows = []
@@ -354,7 +351,7 @@ def main():
                     print_row(rows[-1])
                 if kind == "tcp":
                     try:
-                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds, arg("--before", "")) and ok
+                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds, option("--before", "")) and ok
                     except (RuntimeError, OSError, subprocess.CalledProcessError) as e:
                         print("FAIL: status vs nginx: %s" % e)
                         ok = False

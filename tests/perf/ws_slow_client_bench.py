@@ -17,20 +17,17 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
 from daemon import Daemon  # noqa: E402
+from script_args import flag, option  # noqa: E402
 from ws_util import TelemetryReader, stalled_client  # noqa: E402
 
 TOLERANCE = 0.15
 
 
-def arg(name, default):
-    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
-
-
 def main():
-    smoke = "--smoke" in sys.argv
-    rate_hz = arg("--rate-hz", 20.0)
-    seconds = arg("--seconds", 6.0 if smoke else 60.0)
-    window_s = arg("--window-s", 2.0 if smoke else 5.0)
+    smoke = flag("--smoke")
+    rate_hz = option("--rate-hz", 20.0)
+    seconds = option("--seconds", 6.0 if smoke else 60.0)
+    window_s = option("--window-s", 2.0 if smoke else 5.0)
     tmp = tempfile.mkdtemp(prefix="synbench-ws-slow-bench-")
     d = Daemon(sys.argv[1], os.path.join(tmp, "data"))
     dropped_at = []
@@ -54,7 +51,8 @@ def main():
         rc, _ = d.stop(read_stderr=False)
     times = [t for t in good.times if t0 <= t < t0 + seconds]
     windows = int(seconds // window_s)
-    rates = [sum(1 for t in times if t0 + w * window_s <= t < t0 + (w + 1) * window_s) / window_s for w in range(windows)]
+    starts = [t0 + w * window_s for w in range(windows)]
+    rates = [sum(1 for t in times if lo <= t < lo + window_s) / window_s for lo in starts]
     gaps = [b - a for a, b in zip(times, times[1:])]
     worst = max(rates, key=lambda r: abs(r - rate_hz)) if rates else float("nan")
     print("good client at %g Hz for %.0f s while a client stalls, in %g s windows:" % (rate_hz, seconds, window_s))
@@ -62,11 +60,11 @@ def main():
         worst, len(times) / seconds, min(rates or [float("nan")]), max(rates or [float("nan")]),
         "within" if rates and abs(worst - rate_hz) <= TOLERANCE * rate_hz else "NOT within", rate_hz, 100 * TOLERANCE))
     print("  longest gap between two messages: %.0f ms" % (1000 * max(gaps) if gaps else float("nan")))
-    print("  slow client dropped after %s" % ("%.1f s" % (dropped_at[0] - t0) if dropped_at else "-- (not within the run)"))
+    print("  slow client dropped after %s" % ("%.1f s" % (dropped_at[0] - t0) if dropped_at else "-- (not in the run)"))
     if good.errors:
         print("  the good client's connection ended: %s" % good.errors)
     if smoke and (not times or good.errors or rc != 0):
-        print("FAIL: the good client received no telemetry or lost its connection, or the daemon did not exit 0 (%s)" % rc)
+        print("FAIL: the good client got no telemetry or lost its connection, or the daemon exited %s" % rc)
         sys.exit(1)
 
 

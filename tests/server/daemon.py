@@ -94,6 +94,21 @@ def raw_request(port, lines, timeout=5):
     return (int(parts[1]) if len(parts) > 1 and parts[1].isdigit() else 0), headers, body
 
 
+def send_raw(port, data, timeout=10):
+    """Sends raw bytes on a connection of its own; the reply, read until the server closes it."""
+    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    try:
+        s.sendall(data)
+        reply = b""
+        while True:
+            chunk = s.recv(4096)
+            if not chunk:
+                return reply
+            reply += chunk
+    finally:
+        s.close()
+
+
 def upgrade_lines(host, origin=None, path="/ws"):
     """The lines of a WebSocket upgrade request (for raw_request or a socket of one's own)."""
     lines = ["GET %s HTTP/1.1" % path]
@@ -134,8 +149,8 @@ class Daemon:
 
     def start(self):
         """Starts (or, after a crash, restarts) the process; raises RuntimeError if it says no port."""
-        self.proc = subprocess.Popen([self.binary, "serve", "--listen", "127.0.0.1:0", "--data-dir", self.data_dir,
-                                      *self.extra_args], stdout=subprocess.PIPE, stderr=self.stderr, text=True, env=self.env)
+        cmd = [self.binary, "serve", "--listen", "127.0.0.1:0", "--data-dir", self.data_dir, *self.extra_args]
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.stderr, text=True, env=self.env)
         self.lines = Lines(self.proc.stdout)
         line = self.lines.get(self.start_timeout_s)
         m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line or "")

@@ -26,6 +26,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
 from daemon import Daemon, upgrade_lines  # noqa: E402
+from script_args import option  # noqa: E402
 
 BIN = sys.argv[1]
 TRIALS = 20
@@ -150,7 +151,7 @@ def measure(d, name, kept=None, limit_ms=LIMIT_MS):
 
 
 def main():
-    seconds = float(sys.argv[sys.argv.index("--seconds-per-attack") + 1]) if "--seconds-per-attack" in sys.argv else 6.0
+    seconds = option("--seconds-per-attack", 6.0)
     tmp = tempfile.mkdtemp(prefix="synbench_attack_")
     # The daemon's stderr to a file: nobody may block it by not reading a pipe.
     d = Daemon(BIN, os.path.join(tmp, "data"), log_path=os.path.join(tmp, "serve.log"))

@@ -179,9 +179,14 @@ def exchange(port, data, timeout=5):
     return int(m.group(1)), headers, body
 
 
+def auth_headers(d):
+    """Host and Authorization as the daemon wants them, as bytes (the raw requests here are bytes)."""
+    return [(b"Host", d.host.encode()), (b"Authorization", b"Bearer " + d.operator.encode())]
+
+
 def request_bytes(d, method, target, body=None, headers=None):
     lines = [method + b" " + target + b" HTTP/1.1"]
-    hs = headers if headers is not None else [(b"Host", d.host.encode()), (b"Authorization", b"Bearer " + d.operator.encode())]
+    hs = headers if headers is not None else auth_headers(d)
     for k, v in hs:
         lines.append(k + b": " + v)
     if body is not None:
@@ -206,22 +211,23 @@ def http_input(d):
         return "body", request_bytes(d, b"POST", pick(BODY_ROUTES), body), None
     if kind == 3:
         method, path = pick(ROUTES)
-        hs = [(b"Host", d.host.encode()), (b"Authorization", b"Bearer " + d.operator.encode())]
+        hs = auth_headers(d)
+        host, token = hs[0][1], d.operator.encode()
         op = rng.randrange(6)
         expect_400 = False
         if op == 0:
-            hs.append((b"Host", pick([d.host.encode(), b"evil.example", b"\xff"])))
+            hs.append((b"Host", pick([host, b"evil.example", b"\xff"])))
             expect_400 = True
         elif op == 1:
-            hs[0] = (b"Host", mutate_bytes(d.host.encode()).replace(b"\r", b"").replace(b"\n", b""))
+            hs[0] = (b"Host", mutate_bytes(host).replace(b"\r", b"").replace(b"\n", b""))
         elif op == 2:
-            hs[1] = (b"Authorization", pick([b"Bearer \xff", b"Bearer " + d.operator.encode() + b"\xc3", b"\xff\xfe", b"Bearer " + b"%ff" * 40]))
+            hs[1] = (b"Authorization", pick([b"Bearer \xff", b"Bearer " + token + b"\xc3", b"\xff\xfe", b"Bearer " + b"%ff" * 40]))
         elif op == 3:
             hs.append((pick([b"If-None-Match", b"Origin", b"X-\xff", b"Accept"]), pick(PATH_BITS + [b"W/\"\xff\""])))
         elif op == 4:
             hs += [(b"Upgrade", b"websocket"), (b"Connection", b"Upgrade"), (b"Sec-WebSocket-Version", pick([b"13", b"\xff", b"8"])),
                    (b"Sec-WebSocket-Key", pick([b"dGhlIHNhbXBsZSBub25jZQ==", b"\xff", b""])),
-                   (b"Origin", pick([b"http://" + d.host.encode(), b"http://\xff", b"null"]))]
+                   (b"Origin", pick([b"http://" + host, b"http://\xff", b"null"]))]
             path = b"/ws"
         else:
             hs += [(b"X-Pad-%d" % i, b"v") for i in range(rng.randint(1, 60))]
@@ -366,10 +372,10 @@ def main():
     os.makedirs(data_dir)
     # A stored sweep whose points make a WebSocket reply over the limit (570 points, about 1 kB
     # each: 0.59 MB against 0.5 MiB; 5 s on the twin).
-    r = run_sweep(BIN, {"name": "fuzz", "window_s": 0.2,
-                        "dimensions": {"speed_rpm": [100, 300, 500, 700, 900], "load_Nm": {"from": 0.5, "to": 3.0, "step": 0.5},
-                                       "angle_deg": {"from": 40, "to": 76, "step": 2}}},
-                  os.path.join(data_dir, "synbench.db"), tmp, "--quiet", timeout=600)
+    plan = {"name": "fuzz", "window_s": 0.2,
+            "dimensions": {"speed_rpm": [100, 300, 500, 700, 900], "load_Nm": {"from": 0.5, "to": 3.0, "step": 0.5},
+                           "angle_deg": {"from": 40, "to": 76, "step": 2}}}
+    r = run_sweep(BIN, plan, os.path.join(data_dir, "synbench.db"), tmp, "--quiet", timeout=600)
     check(r.returncode == 0, "a sweep of 570 points into the data dir (%s)" % r.stderr[-300:])
     log = open(os.path.join(tmp, "serve.log"), "w")
     d = Daemon(BIN, data_dir, stderr=log)

@@ -138,7 +138,8 @@ def run_link(kind, tmp):
         link = fs.rtu_link(pair.b) if pair else fs.tcp_link(emu.port)
         cfg = fs.write_bench_config(os.path.join(tmp, kind + "_bench.json"), link)
         data_dir = os.path.join(tmp, kind + "_data")
-        serve = Daemon(BIN, data_dir, ["--bench", cfg], log_path=os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
+        serve = Daemon(BIN, data_dir, ["--bench", cfg], log_path=os.path.join(tmp, kind + "_serve.log"),
+                       start_timeout_s=SLOW_S)
         status, devices = serve.request("GET", "/api/devices")
         check(status == 200 and all(d.get("backend") == "modbus" for d in devices),
               "%s: the daemon's devices are Modbus devices (%s)" % (kind, devices))
@@ -373,8 +374,8 @@ def run_slow(tmp):
     serve = None
     try:
         cfg = fs.write_bench_config(os.path.join(tmp, "slow_bench.json"), fs.tcp_link(emu.port))
-        serve = Daemon(BIN, os.path.join(tmp, "slow_data"), ["--bench", cfg], log_path=os.path.join(tmp, "slow_serve.log"),
-                       start_timeout_s=SLOW_S)
+        serve = Daemon(BIN, os.path.join(tmp, "slow_data"), ["--bench", cfg],
+                       log_path=os.path.join(tmp, "slow_serve.log"), start_timeout_s=SLOW_S)
         time.sleep(1.0)  # the bench thread is now in its slow ticks
         worst = {}
         for path in ("/api/health", "/api/bench/status", "/metrics"):

@@ -18,7 +18,7 @@ import tempfile
 import time
 
 from checks import Checks
-from daemon import Daemon, run_sweep
+from daemon import Daemon, run_sweep, send_raw
 
 BIN = sys.argv[1]
 check = Checks(verbose=False)
@@ -229,29 +229,13 @@ def main():
         check(s == 403, "Host with another port -> 403")
         # Two Host headers (both allowed or not): 400, never a pick of one.
         for second in ("127.0.0.1:%d" % d.port, "evil.example"):
-            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
-            raw.sendall(("GET /api/health HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: %s\r\nConnection: close\r\n\r\n"
-                         % (d.port, second)).encode())
-            reply = b""
-            while True:
-                chunk = raw.recv(4096)
-                if not chunk:
-                    break
-                reply += chunk
-            raw.close()
+            reply = send_raw(d.port, ("GET /api/health HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: %s\r\nConnection: close\r\n\r\n"
+                                      % (d.port, second)).encode())
             check(reply.startswith(b"HTTP/1.1 400") and b"more than one Host" in reply, "duplicate Host (%s) -> 400" % second)
         # A path or parameter that is not UTF-8: a JSON answer, never a crash.
         for path, status in (("/api/\xff", 404), ("/\xff.js", 404), ("/api/sweeps/%ff", 400), ("/api/sweeps/1/points?format=%ff", 400)):
-            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
-            raw.sendall(b"GET " + path.encode("latin-1") + ("" " HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nAuthorization: Bearer %s\r\n"
-                                                           "Connection: close\r\n\r\n" % (d.port, viewer)).encode())
-            reply = b""
-            while True:
-                chunk = raw.recv(4096)
-                if not chunk:
-                    break
-                reply += chunk
-            raw.close()
+            reply = send_raw(d.port, b"GET " + path.encode("latin-1") + (
+                " HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nAuthorization: Bearer %s\r\nConnection: close\r\n\r\n" % (d.port, viewer)).encode())
             head, _, body = reply.partition(b"\r\n\r\n")
             try:
                 doc = json.loads(body.decode("utf-8"))

@@ -33,8 +33,9 @@ def serve_exits(data_dir):
 
 
 def tiny_sweep(db, tmp):
-    r = run_sweep(BIN, {"name": "tiny", "window_s": 0.2,
-                        "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 48, 52, 56]}}, db, tmp, "--quiet")
+    plan = {"name": "tiny", "window_s": 0.2,
+            "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 48, 52, 56]}}
+    r = run_sweep(BIN, plan, db, tmp, "--quiet")
     check(r.returncode == 0, "a tiny sweep into %s (%s)" % (db, r.stderr[-300:]))
 
 

@@ -19,10 +19,11 @@ import time
 
 from checks import Checks
 from daemon import Daemon
+from script_args import option
 from ws_util import TelemetryReader, stalled_client
 
 BIN = sys.argv[1]
-SECONDS = float(sys.argv[sys.argv.index("--seconds") + 1]) if "--seconds" in sys.argv else 60.0
+SECONDS = option("--seconds", 60.0)
 check = Checks(verbose=True)
 
 
