@@ -48,6 +48,8 @@ import urllib.request
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
 import far_side as fs  # noqa: E402
+from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
+from script_args import flag, option  # noqa: E402
 
 SPEED, LOAD_NM, ANGLE = 600.0, 0.5, 50.0
 WATCHDOG_MS = 3000     # the emulator's: a loaded machine may stall the daemon a fraction of a second
@@ -57,10 +59,6 @@ TARGET_MS = {"tcp": 50.0, "rtu": 100.0}
 LOCAL = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # loopback: never through a proxy
 PLAN = {"name": "estop latency", "window_s": 1.0,
         "dimensions": {"speed_rpm": [SPEED], "load_Nm": [LOAD_NM], "angle_deg": [46, 50, 54, 58]}}
-
-
-def arg(name, default):
-    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
 
 
 class TrialError(Exception):
@@ -83,9 +81,9 @@ class Bench:
         self.far = fs.ModbusTcp(self.emu.port)
         link = fs.rtu_link(self.pair.b) if self.pair else fs.tcp_link(self.emu.port)
         cfg = fs.write_bench_config(os.path.join(tmp, kind + "_bench.json"), link)
-        self.serve = fs.Serve(binary, cfg, os.path.join(tmp, kind + "_data"), os.path.join(tmp, kind + "_serve.log"),
-                              start_timeout_s=SLOW_S)
-        self.viewer = self.serve.new_token("viewer")
+        self.serve = Daemon(binary, os.path.join(tmp, kind + "_data"), ["--bench", cfg],
+                            log_path=os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
+        self.viewer = self.serve.token("viewer")
         self.latched = False  # an E-stop was sent since the last successful reset
         status, body = self.serve.request("POST", "/api/bench/setpoints",
                                           {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
@@ -93,7 +91,7 @@ class Bench:
             print("  %s: setpoints -> %s %s" % (kind, status, str(body)[:200]))
 
     def close(self):
-        rc = self.serve.stop()
+        rc, _ = self.serve.stop()
         self.far.close()
         self.emu.stop()
         if self.pair:
@@ -117,7 +115,7 @@ class Bench:
             if status != 200:
                 raise TrialError("reset -> %s %s" % (status, str(body)[:160]))
             self.latched = False
-        if not fs.wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
+        if not wait_for(lambda: all(s == fs.DISABLED and f == 0 for s, f in self.far.states()), 2.0, 0.005):
             raise TrialError("drives not disabled and clear before the trial: %s" % fs.describe(self.far.states()))
         sid = None
         if condition == "sweep":
@@ -132,10 +130,10 @@ class Bench:
             status, body = self.serve.request("POST", "/api/bench/enable", {"enabled": True})
             if status != 200:
                 raise TrialError("enable -> %s %s" % (status, str(body)[:160]))
-        if not fs.wait_for(self.running, SLOW_S, 0.02):
+        if not wait_for(self.running, SLOW_S, 0.02):
             raise TrialError("not at speed: %s, %.0f rpm" % (fs.describe(self.far.states()), self.far.speed_rpm()))
         time.sleep(random.uniform(0, 0.05))
-        pending = fs.PendingRequest(self.serve.port, self.serve.raw_request_bytes("POST", "/api/bench/estop"))
+        pending = PendingRequest(self.serve.port, self.serve.raw_request_bytes("POST", "/api/bench/estop"))
         self.latched = True
         latency = None
         while True:
@@ -153,7 +151,7 @@ class Bench:
                              % (GIVE_UP_S, fs.describe(states), pending.status))
         if pending.status != 200:
             raise TrialError("E-stop -> %s %s" % (pending.status, pending.body[:160] if pending.body else ""))
-        if sid is not None and not fs.wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
+        if sid is not None and not wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
             raise TrialError("sweep %d still running after the E-stop" % sid)
         return latency, pending.answered_at - pending.sent_at
 
@@ -316,13 +314,13 @@ def main():
             print("SKIP: %s is not installed (scripts/debian-packages.txt)" % tool)
             sys.exit(77)
     binary = sys.argv[1]
-    smoke = "--smoke" in sys.argv
-    trials = arg("--trials", 3 if smoke else 50)
-    links = arg("--links", "tcp,rtu").split(",")
-    conditions = arg("--conditions", "idle,sweep,polled").split(",")
-    connections = arg("--connections", 4 if smoke else 50)
-    threads = arg("--threads", 2)
-    seconds = arg("--seconds", 1 if smoke else 10)
+    smoke = flag("--smoke")
+    trials = option("--trials", 3 if smoke else 50)
+    links = option("--links", "tcp,rtu").split(",")
+    conditions = option("--conditions", "idle,sweep,polled").split(",")
+    connections = option("--connections", 4 if smoke else 50)
+    threads = option("--threads", 2)
+    seconds = option("--seconds", 1 if smoke else 10)
     random.seed(1)
     tmp = tempfile.mkdtemp(prefix="synbench_estop_bench_")
     rows = []
@@ -353,7 +351,7 @@ def main():
                     print_row(rows[-1])
                 if kind == "tcp":
                     try:
-                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds, arg("--before", "")) and ok
+                        ok = status_vs_nginx(bench, tmp, connections, threads, seconds, option("--before", "")) and ok
                     except (RuntimeError, OSError, subprocess.CalledProcessError) as e:
                         print("FAIL: status vs nginx: %s" % e)
                         ok = False

@@ -16,11 +16,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
-from ws_util import Daemon  # noqa: E402
-
-
-def arg(name, default):
-    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
+from daemon import Daemon  # noqa: E402
+from script_args import flag, option  # noqa: E402
 
 
 def run_wrk(d, path, token, connections, threads, seconds):
@@ -40,10 +37,10 @@ def main():
     if not shutil.which("wrk"):
         print("SKIP: wrk is not installed")
         sys.exit(1 if os.environ.get("CI") else 77)  # CI installs it (scripts/debian-packages.txt)
-    smoke = "--smoke" in sys.argv
-    connections = arg("--connections", 4 if smoke else 50)
-    threads = arg("--threads", 2)
-    seconds = arg("--seconds", 1 if smoke else 10)
+    smoke = flag("--smoke")
+    connections = option("--connections", 4 if smoke else 50)
+    threads = option("--threads", 2)
+    seconds = option("--seconds", 1 if smoke else 10)
     tmp = tempfile.mkdtemp(prefix="synbench-wrk-")
     d = Daemon(sys.argv[1], os.path.join(tmp, "data"))
     ok = True

@@ -16,11 +16,9 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "server"))
-from ws_util import Daemon, connect, recv_until  # noqa: E402
-
-
-def arg(name, default):
-    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
+from daemon import Daemon  # noqa: E402
+from script_args import flag, option  # noqa: E402
+from ws_util import connect, recv_until  # noqa: E402
 
 
 def cpu_s(pid):
@@ -35,10 +33,10 @@ def percentile(xs, p):
 
 
 def main():
-    smoke = "--smoke" in sys.argv
-    clients = arg("--clients", 5 if smoke else 50)
-    rate_hz = arg("--rate-hz", 20.0)
-    seconds = arg("--seconds", 3.0 if smoke else 30.0)
+    smoke = flag("--smoke")
+    clients = option("--clients", 5 if smoke else 50)
+    rate_hz = option("--rate-hz", 20.0)
+    seconds = option("--seconds", 3.0 if smoke else 30.0)
     tmp = tempfile.mkdtemp(prefix="synbench-ws-bench-")
     d = Daemon(sys.argv[1], os.path.join(tmp, "data"))
     try:

@@ -7,24 +7,20 @@ import subprocess
 import sys
 import tempfile
 
+from checks import Checks
+
 BIN = sys.argv[1]
 RECORD_FIELDS = """speed_rpm load_Nm angle_deg estimator pwm speed_meas_rpm im_A id_A iq_A ud_V uq_V
 udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W efficiency pos_err_min_deg pos_err_mean_deg pos_err_max_deg
 speed_err_rpm ld_est_H lq_est_H rs_est_ohm ld_err_pct lq_err_pct rs_err_pct temp_C window_s samples
 settle_s voltage_limited unstable fault below_min_speed fallback_fraction lock_lost window_source fault_code_raw truth""".split()
 TRUTH_FIELDS = "pin_W pcu_W pfe_W pmech_W pinvm_W pm_W temp_C".split()
-failures = []
+check = Checks(verbose=True)
 
 
 def run(*args):
     p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=120)
     return p.returncode, p.stdout, p.stderr
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
 
 
 code, out, _ = run("--version")
@@ -143,5 +139,4 @@ code, out, _ = run("point", "--speed-rpm", "300", "--load-Nm", "1.5", "--angle-d
 check(code == 0 and json.loads(out)["below_min_speed"] is False and json.loads(out)["fallback_fraction"] == 0,
       "encoder at 300 rpm: not flagged")
 
-print(f"{(len(failures) == 0) and 'all' or len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
-sys.exit(1 if failures else 0)
+check.finish("all checks passed")

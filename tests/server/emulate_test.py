@@ -16,6 +16,8 @@ import sys
 import tempfile
 import time
 
+from checks import Checks
+
 BIN = sys.argv[1]
 TIME_SCALE = 20  # twin seconds per wall second, on both sides
 # At 20x the firmware's 500 ms watchdog is 25 ms of wall time: a loaded CI machine can stall
@@ -24,7 +26,7 @@ SCALED = ["--time-scale", str(TIME_SCALE), "--watchdog-timeout-ms", "5000"]
 POINT = ["--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52", "--json"]
 MEASURED = """speed_meas_rpm im_A id_A iq_A ud_V uq_V udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W
 efficiency""".split()
-failures = []
+check = Checks(verbose=True)
 tmp = tempfile.mkdtemp(prefix="synbench_emulate_test_")
 
 for tool in ("mbpoll", "socat"):
@@ -36,12 +38,6 @@ for tool in ("mbpoll", "socat"):
 def run(*args, timeout=120):
     p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=timeout)
     return p.returncode, p.stdout, p.stderr
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
 
 
 class Emulator:
@@ -253,5 +249,4 @@ if code == 0:
           "the in-process register map gives the direct record to f32 precision")
 
 shutil.rmtree(tmp, ignore_errors=True)
-print(f"{(len(failures) == 0) and 'all' or len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
-sys.exit(1 if failures else 0)
+check.finish("all checks passed")

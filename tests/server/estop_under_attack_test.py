@@ -13,7 +13,6 @@ must answer 200 within 100 ms, the daemon must stay up, and the bench must read 
 Prints per attack the E-stop latencies (p50, max) and how many connections the daemon closed to
 make room. usage: estop_under_attack_test.py path/to/synbench [--seconds-per-attack 6]"""
 import http.client
-import json
 import os
 import shutil
 import socket
@@ -25,32 +24,14 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ws_util import Daemon  # noqa: E402
+from checks import Checks  # noqa: E402
+from daemon import Daemon, upgrade_lines  # noqa: E402
+from script_args import option  # noqa: E402
 
 BIN = sys.argv[1]
 TRIALS = 20
 LIMIT_MS = 100.0
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    if not cond:
-        failures.append(what)
-
-
-def request(d, method, path, token, body=None, timeout=10):
-    conn = http.client.HTTPConnection("127.0.0.1", d.port, timeout=timeout)
-    headers = {"Host": d.host, "Authorization": "Bearer " + token}
-    data = None
-    if body is not None:
-        data = json.dumps(body)
-        headers["Content-Type"] = "application/json"
-    conn.request(method, path, body=data, headers=headers)
-    r = conn.getresponse()
-    raw = r.read()
-    conn.close()
-    return r.status, raw
+check = Checks(verbose=True)
 
 
 class Attack:
@@ -92,8 +73,7 @@ def slowloris(d, attack, conns):
 
 
 def ws_idle(d, attack, conns):
-    upgrade = ("GET /ws HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n" % d.host).encode()
+    upgrade = ("\r\n".join(upgrade_lines(d.host)) + "\r\n\r\n").encode()
 
     def one(_):
         while not attack.stopping.is_set():
@@ -123,7 +103,7 @@ def estimates(d, attack, viewer, operator):
         token = operator if i < 2 else viewer
         while not attack.stopping.is_set():
             try:
-                request(d, "POST", "/api/sweeps/estimate", token, plan, timeout=30)
+                d.http("POST", "/api/sweeps/estimate", plan, token=token, timeout=30)
             except OSError:
                 time.sleep(0.05)
 
@@ -149,7 +129,7 @@ def measure(d, name, kept=None, limit_ms=LIMIT_MS):
     for _ in range(TRIALS):
         t0 = time.perf_counter()
         try:
-            status, raw = kept.estop() if kept else request(d, "POST", "/api/bench/estop", d.operator, timeout=10)
+            status, raw = kept.estop() if kept else d.http("POST", "/api/bench/estop", token=d.operator, timeout=10)[:2]
         except (OSError, http.client.HTTPException) as e:
             status, raw = 0, str(e).encode()
         ms = (time.perf_counter() - t0) * 1000
@@ -158,7 +138,7 @@ def measure(d, name, kept=None, limit_ms=LIMIT_MS):
         else:
             bad.append("%s %s" % (status, raw[:120]))
         try:
-            request(d, "POST", "/api/bench/reset", d.operator, timeout=10)
+            d.http("POST", "/api/bench/reset", token=d.operator, timeout=10)
         except OSError:
             pass
         time.sleep(0.05)
@@ -171,15 +151,13 @@ def measure(d, name, kept=None, limit_ms=LIMIT_MS):
 
 
 def main():
-    seconds = float(sys.argv[sys.argv.index("--seconds-per-attack") + 1]) if "--seconds-per-attack" in sys.argv else 6.0
+    seconds = option("--seconds-per-attack", 6.0)
     tmp = tempfile.mkdtemp(prefix="synbench_attack_")
-    log = open(os.path.join(tmp, "serve.log"), "w")
-    d = Daemon(BIN, os.path.join(tmp, "data"))
     # The daemon's stderr to a file: nobody may block it by not reading a pipe.
-    threading.Thread(target=lambda: shutil.copyfileobj(d.proc.stderr, log), daemon=True).start()
+    d = Daemon(BIN, os.path.join(tmp, "data"), log_path=os.path.join(tmp, "serve.log"))
     viewer = d.token("viewer")
     try:
-        status, _ = request(d, "POST", "/api/bench/setpoints", d.operator, {"speed_rpm": 300, "angle_deg": 50})
+        status, _ = d.http("POST", "/api/bench/setpoints", {"speed_rpm": 300, "angle_deg": 50}, token=d.operator)[:2]
         check(status == 200, "setpoints before the attacks (%s)" % status)
         measure(d, "no attack")
         attacks = [("slowloris", lambda a: slowloris(d, a, 180)), ("ws-idle", lambda a: ws_idle(d, a, 60)),
@@ -195,7 +173,7 @@ def main():
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             kept = KeptConnection(d)
             kept.estop()  # opened (and trusted) before the flood is in full swing
-            request(d, "POST", "/api/bench/reset", d.operator)
+            d.http("POST", "/api/bench/reset", token=d.operator)
             time.sleep(2)
             measure(d, "flood (wrk -c300), the operator's open connection", kept=kept)
             # A new connection waits its turn among the flood's reconnections in the accept queue
@@ -205,18 +183,16 @@ def main():
             wrk.wait()
         else:
             print("note: wrk is absent: the flood is not tried")
-        metrics = request(d, "GET", "/metrics", d.operator)[1].decode()
+        metrics = d.http("GET", "/metrics", token=d.operator)[1].decode()
         evicted = [line for line in metrics.splitlines() if line.startswith("synbench_http_connections_evicted_total")]
         print("     " + (evicted[0] if evicted else "no eviction counter in /metrics"))
-        status, raw = request(d, "GET", "/api/bench/status", d.operator)
+        status, raw = d.http("GET", "/api/bench/status", token=d.operator)[:2]
         check(status == 200 and d.proc.poll() is None, "the daemon is up and answers after the attacks")
     finally:
-        code, _ = d.stop(read_stderr=False)
-        log.close()
+        code, _ = d.stop()
         check(code == 0, "SIGTERM -> exit 0 (%s)" % code)
         shutil.rmtree(tmp, ignore_errors=True)
-    print("all checks passed" if not failures else "%d checks FAILED" % len(failures))
-    sys.exit(1 if failures else 0)
+    check.finish("all checks passed")
 
 
 if __name__ == "__main__":

@@ -1,22 +1,21 @@
 """The bench seen from the far side, for tests and benchmarks of `synbench serve --bench` on
 `synbench emulate`: a small Modbus TCP master of its own (standard library only) that reads the
-drives' registers straight from the emulator, the emulator and the daemon as processes, socat
-pseudo-terminal pairs, bench configs. What the daemon says about the drives is never taken as
-evidence here; the registers are.
+drives' registers straight from the emulator, the emulator as a process, socat pseudo-terminal
+pairs, bench configs (the daemon itself: daemon.py). What the daemon says about the drives is
+never taken as evidence here; the registers are.
 
 Register addresses and scalings: drivers/profiles/*.json, docs/register-map.md (0-based
 protocol addresses; f32 and u32 big-endian words, high word first)."""
-import http.client
 import json
 import os
-import queue
 import re
 import signal
 import socket
 import struct
 import subprocess
-import threading
 import time
+
+from daemon import Lines
 
 SYNRM, LOAD = 1, 2  # unit ids of the default profiles
 STATES = {0: "disabled", 1: "running", 2: "stopping", 3: "faulted"}
@@ -35,16 +34,6 @@ TORQUE_SETPOINT = 16  # load holding 16-17, f32 N m
 SPEED = 16            # SynRM input 16-17, f32 rpm
 TORQUE = 16           # load input 16-17, f32 N m
 UDC = 30              # SynRM input 30, u16, 0.1 V
-
-
-def wait_for(pred, timeout_s, period_s=0.02):
-    """Polls pred() until it returns a true value (returned) or the time is up (the last value)."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        v = pred()
-        if v or time.monotonic() > deadline:
-            return v
-        time.sleep(period_s)
 
 
 class ModbusError(Exception):
@@ -155,25 +144,6 @@ def describe(states):
     return "synrm %s/%s, load %s/%s" % (STATES.get(s1, s1), FAULTS.get(f1, f1), STATES.get(s2, s2), FAULTS.get(f2, f2))
 
 
-class Lines:
-    """A process's stdout lines on a queue (read by a thread, so the pipe never fills)."""
-
-    def __init__(self, stream):
-        self.q = queue.Queue()
-        threading.Thread(target=self._pump, args=(stream,), daemon=True).start()
-
-    def _pump(self, stream):
-        for line in stream:
-            self.q.put(line.rstrip("\n"))
-        self.q.put(None)
-
-    def get(self, timeout):
-        try:
-            return self.q.get(timeout=timeout)
-        except queue.Empty:
-            return None
-
-
 class Emulator:
     """`synbench emulate` with its TCP link on a free loopback port (and RTU when asked)."""
 
@@ -255,129 +225,3 @@ def rtu_link(device):
     # A timeout is followed by a drain until the line is quiet: tens of ms, not the default 200
     # (docs/modbus.md), or two lost replies in a tick cost the 0.5 s telemetry deadline.
     return {"transport": "rtu", "device": device, "baud": 115200, "response_timeout_ms": 200, "quiet_ms": 20}
-
-
-class Serve:
-    """`synbench serve --bench CFG` on a free loopback port; stderr to a log file."""
-
-    def __init__(self, binary, bench_config, data_dir, log_path, start_timeout_s=60):
-        self.log = open(log_path, "w")
-        self.log_path = log_path
-        self.binary, self.data_dir = binary, data_dir
-        self.proc = subprocess.Popen([binary, "serve", "--bench", bench_config, "--listen", "127.0.0.1:0",
-                                      "--data-dir", data_dir], stdout=subprocess.PIPE, stderr=self.log, text=True)
-        self.lines = Lines(self.proc.stdout)
-        line = self.lines.get(start_timeout_s)
-        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line or "")
-        if not m:
-            self.kill()
-            raise RuntimeError("serve did not start: %r (%s)" % (line, open(log_path).read()[-800:]))
-        self.port = int(m.group(1))
-        self.host = "127.0.0.1:%d" % self.port
-        self.token = open(os.path.join(data_dir, "operator.token")).read().strip()
-
-    def new_token(self, role):
-        r = subprocess.run([self.binary, "token", "create", "--role", role, "--data-dir", self.data_dir],
-                           capture_output=True, text=True, check=True)
-        return r.stdout.strip()
-
-    def request(self, method, path, body=None, token=None, timeout=30):
-        """(status, parsed JSON or raw bytes); (0, reason) when the daemon does not answer."""
-        try:
-            conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=timeout)
-            headers = {"Host": self.host, "Authorization": "Bearer " + (token or self.token)}
-            data = None
-            if body is not None:
-                data = json.dumps(body)
-                headers["Content-Type"] = "application/json"
-            conn.request(method, path, body=data, headers=headers)
-            r = conn.getresponse()
-            raw = r.read()
-            conn.close()
-        except (OSError, http.client.HTTPException) as e:
-            return 0, str(e)
-        try:
-            return r.status, json.loads(raw)
-        except ValueError:
-            return r.status, raw
-
-    def raw_request_bytes(self, method, path, body=None):
-        """The bytes of one request, for a caller that sends it on its own socket and times it."""
-        data = json.dumps(body).encode() if body is not None else b""
-        head = "%s %s HTTP/1.1\r\nHost: %s\r\nAuthorization: Bearer %s\r\nContent-Length: %d\r\n" % (
-            method, path, self.host, self.token, len(data))
-        if body is not None:
-            head += "Content-Type: application/json\r\n"
-        return head.encode() + b"\r\n" + data
-
-    def stop(self, timeout_s=40):
-        """SIGTERM; the exit status (None if it had to be killed)."""
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(timeout=timeout_s)
-            except subprocess.TimeoutExpired:
-                self.kill()
-                return None
-        self.log.close()
-        return self.proc.returncode
-
-    def kill(self):
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait()
-        if not self.log.closed:
-            self.log.close()
-
-
-class PendingRequest:
-    """An HTTP request sent on a socket of its own; `poll()` is non-blocking, so a caller can keep
-    reading Modbus while the daemon works on it. sent_at: time.monotonic() just before sending."""
-
-    def __init__(self, port, request_bytes):
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=10)
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.buf = b""
-        self.status = None
-        self.body = None
-        self.answered_at = None
-        self.sent_at = time.monotonic()
-        self.sock.sendall(request_bytes)
-        self.sock.setblocking(False)
-
-    def poll(self):
-        """True once the whole response is in."""
-        if self.status is not None:
-            return True
-        try:
-            chunk = self.sock.recv(65536)
-        except (BlockingIOError, InterruptedError):
-            return False
-        if chunk:
-            self.buf += chunk
-        head, sep, body = self.buf.partition(b"\r\n\r\n")
-        if sep:
-            m = re.search(rb"content-length:\s*(\d+)", head, re.I)
-            length = int(m.group(1)) if m else 0
-            if len(body) >= length or not chunk:
-                self.answered_at = time.monotonic()
-                self.status = int(head.split(b" ", 2)[1])
-                self.body = body[:length]
-                self.sock.close()
-                return True
-        elif not chunk:
-            self.answered_at = time.monotonic()
-            self.status = 0
-            self.sock.close()
-            return True
-        return False
-
-    def wait(self, timeout_s):
-        deadline = time.monotonic() + timeout_s
-        while not self.poll():
-            if time.monotonic() > deadline:
-                self.sock.close()
-                self.status = 0
-                return False
-            time.sleep(0.001)
-        return True

@@ -17,15 +17,18 @@ import random
 import re
 import socket
 import struct
-import subprocess
 import sys
 import tempfile
 import time
 
+from checks import Checks
+from daemon import Daemon, run_sweep
+
 BIN = sys.argv[1]
 SECONDS = float(sys.argv[2]) if len(sys.argv) > 2 else 40
 rng = random.Random(20261122)
-failures = []
+check = Checks(verbose=False)
+failures = check.failures
 
 HOSTILE = [b"1e309", b"-1e309", b"9" * 400, b"-" + b"7" * 400, b"1e-400", b"18446744073709551616", b"-1", b"0", b"null",
            b"true", b'""', b"[]", b"{}", b"[" * 100 + b"]" * 100, b"[" * 3000, b'"\xff"', b'"\xc3"', b'"\\ud800"',
@@ -48,12 +51,6 @@ BODIES = [{"speed_rpm": 500, "load_Nm": 0.5, "angle_deg": 50}, {"enabled": False
           SMALL_PLAN, {"preset": "thesis-grid", "mode": "adaptive"},
           {"dimensions": {"speed_rpm": {"from": 100, "to": 900, "step": 200}, "load_Nm": [0.5], "angle_deg": [40, 50],
                           "configurations": [{"estimator": "ekf-rs", "pwm": "aspwm"}]}}]
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
 
 
 def pick(seq):
@@ -142,43 +139,6 @@ def random_query():
 
 # --- the daemon ------------------------------------------------------------------------------
 
-class Daemon:
-    def __init__(self, data_dir, log):
-        self.data_dir, self.log = data_dir, log
-        self.start()
-
-    def start(self):
-        self.proc = subprocess.Popen([BIN, "serve", "--listen", "127.0.0.1:0", "--data-dir", self.data_dir],
-                                     stdout=subprocess.PIPE, stderr=self.log, text=True)
-        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", self.proc.stdout.readline())
-        if not m:
-            self.proc.kill()
-            raise SystemExit("serve did not start")
-        self.port = int(m.group(1))
-        self.host = b"127.0.0.1:%d" % self.port
-        self.token = open(os.path.join(self.data_dir, "operator.token")).read().strip().encode()
-
-    def alive(self, settle=False):
-        """`settle`: the connection just ended without an answer, which a dying daemon also does:
-        give the kernel a moment to report its exit."""
-        for _ in range(10 if settle else 1):
-            if self.proc.poll() is not None:
-                return False
-            if settle:
-                time.sleep(0.02)
-        return True
-
-    def stop(self):
-        if self.alive():
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        return self.proc.returncode
-
-
 def exchange(port, data, timeout=5):
     """Sends raw bytes; returns (status, headers, body) of the answer, or (None, {}, b"") when the
     server closed without one."""
@@ -219,9 +179,14 @@ def exchange(port, data, timeout=5):
     return int(m.group(1)), headers, body
 
 
+def auth_headers(d):
+    """Host and Authorization as the daemon wants them, as bytes (the raw requests here are bytes)."""
+    return [(b"Host", d.host.encode()), (b"Authorization", b"Bearer " + d.operator.encode())]
+
+
 def request_bytes(d, method, target, body=None, headers=None):
     lines = [method + b" " + target + b" HTTP/1.1"]
-    hs = headers if headers is not None else [(b"Host", d.host), (b"Authorization", b"Bearer " + d.token)]
+    hs = headers if headers is not None else auth_headers(d)
     for k, v in hs:
         lines.append(k + b": " + v)
     if body is not None:
@@ -246,22 +211,23 @@ def http_input(d):
         return "body", request_bytes(d, b"POST", pick(BODY_ROUTES), body), None
     if kind == 3:
         method, path = pick(ROUTES)
-        hs = [(b"Host", d.host), (b"Authorization", b"Bearer " + d.token)]
+        hs = auth_headers(d)
+        host, token = hs[0][1], d.operator.encode()
         op = rng.randrange(6)
         expect_400 = False
         if op == 0:
-            hs.append((b"Host", pick([d.host, b"evil.example", b"\xff"])))
+            hs.append((b"Host", pick([host, b"evil.example", b"\xff"])))
             expect_400 = True
         elif op == 1:
-            hs[0] = (b"Host", mutate_bytes(d.host).replace(b"\r", b"").replace(b"\n", b""))
+            hs[0] = (b"Host", mutate_bytes(host).replace(b"\r", b"").replace(b"\n", b""))
         elif op == 2:
-            hs[1] = (b"Authorization", pick([b"Bearer \xff", b"Bearer " + d.token + b"\xc3", b"\xff\xfe", b"Bearer " + b"%ff" * 40]))
+            hs[1] = (b"Authorization", pick([b"Bearer \xff", b"Bearer " + token + b"\xc3", b"\xff\xfe", b"Bearer " + b"%ff" * 40]))
         elif op == 3:
             hs.append((pick([b"If-None-Match", b"Origin", b"X-\xff", b"Accept"]), pick(PATH_BITS + [b"W/\"\xff\""])))
         elif op == 4:
             hs += [(b"Upgrade", b"websocket"), (b"Connection", b"Upgrade"), (b"Sec-WebSocket-Version", pick([b"13", b"\xff", b"8"])),
                    (b"Sec-WebSocket-Key", pick([b"dGhlIHNhbXBsZSBub25jZQ==", b"\xff", b""])),
-                   (b"Origin", pick([b"http://" + d.host, b"http://\xff", b"null"]))]
+                   (b"Origin", pick([b"http://" + host, b"http://\xff", b"null"]))]
             path = b"/ws"
         else:
             hs += [(b"X-Pad-%d" % i, b"v") for i in range(rng.randint(1, 60))]
@@ -271,7 +237,7 @@ def http_input(d):
             return None if status == 400 else "duplicate Host answered %s" % status
         return "header", raw, dup_host if expect_400 else None
     # Odd framing: chunked with bad sizes, a short Content-Length, garbage.
-    raw = pick([b"POST /api/sweeps/estimate HTTP/1.1\r\nHost: " + d.host + b"\r\nTransfer-Encoding: chunked\r\n\r\n" +
+    raw = pick([b"POST /api/sweeps/estimate HTTP/1.1\r\nHost: " + d.host.encode() + b"\r\nTransfer-Encoding: chunked\r\n\r\n" +
                 pick([b"zz\r\n", b"ffffffffffffffffff\r\n", b"5\r\n{\"a\":\r\n0\r\n\r\n"]),
                 request_bytes(d, b"POST", b"/api/bench/setpoints", b'{"speed_rpm": 5}')[:-3],
                 mutate_bytes(request_bytes(d, b"GET", b"/api/health")), os.urandom(rng.randint(1, 300)) + b"\r\n\r\n"])
@@ -298,7 +264,7 @@ class RawWs:
     def __init__(self, d):
         self.s = socket.create_connection(("127.0.0.1", d.port), timeout=5)
         key = base64.b64encode(os.urandom(16))
-        self.s.sendall(b"GET /ws HTTP/1.1\r\nHost: " + d.host + b"\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        self.s.sendall(b"GET /ws HTTP/1.1\r\nHost: " + d.host.encode() + b"\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
                        b"Sec-WebSocket-Key: " + key + b"\r\nSec-WebSocket-Version: 13\r\n\r\n")
         head = b""
         while b"\r\n\r\n" not in head:
@@ -378,7 +344,7 @@ def ws_messages(token):
 
 def ws_connect(d):
     ws = RawWs(d)
-    ws.send(json.dumps({"op": "auth", "token": d.token.decode()}).encode())
+    ws.send(json.dumps({"op": "auth", "token": d.operator}).encode())
     hello = ws.recv(5)
     if not hello or json.loads(hello).get("type") != "hello":
         raise ConnectionError("no hello: %r" % hello)
@@ -406,16 +372,13 @@ def main():
     os.makedirs(data_dir)
     # A stored sweep whose points make a WebSocket reply over the limit (570 points, about 1 kB
     # each: 0.59 MB against 0.5 MiB; 5 s on the twin).
-    plan = os.path.join(tmp, "plan.json")
-    with open(plan, "w") as f:
-        json.dump({"name": "fuzz", "window_s": 0.2,
-                   "dimensions": {"speed_rpm": [100, 300, 500, 700, 900], "load_Nm": {"from": 0.5, "to": 3.0, "step": 0.5},
-                                  "angle_deg": {"from": 40, "to": 76, "step": 2}}}, f)
-    r = subprocess.run([BIN, "sweep", plan, "--db", os.path.join(data_dir, "synbench.db"), "--quiet"],
-                       capture_output=True, text=True, timeout=600)
+    plan = {"name": "fuzz", "window_s": 0.2,
+            "dimensions": {"speed_rpm": [100, 300, 500, 700, 900], "load_Nm": {"from": 0.5, "to": 3.0, "step": 0.5},
+                           "angle_deg": {"from": 40, "to": 76, "step": 2}}}
+    r = run_sweep(BIN, plan, os.path.join(data_dir, "synbench.db"), tmp, "--quiet", timeout=600)
     check(r.returncode == 0, "a sweep of 570 points into the data dir (%s)" % r.stderr[-300:])
     log = open(os.path.join(tmp, "serve.log"), "w")
-    d = Daemon(data_dir, log)
+    d = Daemon(BIN, data_dir, stderr=log)
     counts = {"http": [0, 0, 0], "ws": [0, 0, 0]}  # inputs, crashes, 5xx
     shown = 0
 
@@ -467,7 +430,7 @@ def main():
         ws.close()
 
         # WebSocket messages: the rest of the budget.
-        seeds = ws_messages(d.token.decode())
+        seeds = ws_messages(d.operator)
         ws = None
         while time.time() - t0 < SECONDS:
             if ws is None or ws.closed:
@@ -507,7 +470,7 @@ def main():
         if ws is not None:
             ws.close()
     finally:
-        rc = d.stop()
+        rc, _ = d.stop()
         log.close()
     check(rc == 0, "SIGTERM after the fuzz -> exit 0 (got %s)" % rc)
     caught = [line for line in open(os.path.join(tmp, "serve.log"), errors="replace") if "internal error" in line or "caught" in line]
@@ -518,10 +481,7 @@ def main():
         n, crashes, five = counts[kind]
         print("%s: inputs tried %d, crashes %d, 5xx %d" % (name, n, crashes, five))
         check(crashes == 0 and five == 0, "%s: no crash, no 5xx" % name)
-    if failures:
-        print("%d failure(s)" % len(failures))
-        sys.exit(1)
-    print("fuzz test ok")
+    check.finish("fuzz test ok")
 
 
 if __name__ == "__main__":

@@ -20,26 +20,14 @@ import sys
 import tempfile
 import time
 
+from checks import Checks
+from daemon import Daemon
+
 BIN = sys.argv[1]
 COUNT = int(sys.argv[2]) if len(sys.argv) > 2 else 10000
 rng = random.Random(20261122)
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
-
-
-def start(data_dir):
-    proc = subprocess.Popen([BIN, "serve", "--listen", "127.0.0.1:0", "--data-dir", data_dir],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", proc.stdout.readline())
-    if not m:
-        proc.kill()
-        raise SystemExit("serve did not start")
-    return proc, int(m.group(1))
+check = Checks(verbose=False)
+failures = check.failures
 
 
 BAD_JSON = ['{', '{"speed_rpm": }', '[1, 2', '{"a": 1,}', 'null', '"text"', '42', '[]', 'true', '{"x": NaN}',
@@ -128,9 +116,8 @@ def raw_exchange(port, data):
 def main():
     tmp = tempfile.mkdtemp(prefix="synbench-hostile-")
     data_dir = os.path.join(tmp, "data")
-    proc, port = start(data_dir)
-    op = open(os.path.join(data_dir, "operator.token")).read().strip()
-    host = "127.0.0.1:%d" % port
+    d = Daemon(BIN, data_dir, stderr=subprocess.DEVNULL)
+    proc, port, op, host = d.proc, d.port, d.operator, d.host
     auth = {"Host": host, "Authorization": "Bearer " + op, "Content-Type": "application/json"}
     client = Client(port)
     statuses = collections.Counter()
@@ -220,17 +207,9 @@ def main():
         check(r.status == 200 and json.loads(r.read()) == [], "no invalid plan created a sweep")
         c.close()
     finally:
-        proc.terminate()
-        try:
-            rc = proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            rc = -1
+        rc, _ = d.stop()
         check(rc == 0, "SIGTERM after the storm -> exit 0 (got %s)" % rc)
-    if failures:
-        print("%d failure(s)" % len(failures))
-        sys.exit(1)
-    print("hostile test ok")
+    check.finish("hostile test ok")
 
 
 if __name__ == "__main__":

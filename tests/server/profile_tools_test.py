@@ -20,6 +20,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 import far_side  # noqa: E402
 
 BIN = sys.argv[1]
@@ -29,7 +30,7 @@ TIME_SCALE = 20
 # At 20x the firmware's 500 ms watchdog is 25 ms of wall time (see emulate_test.py).
 SCALED = ["--time-scale", str(TIME_SCALE), "--watchdog-timeout-ms", "5000"]
 POINT = ["--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52", "--json"]
-failures = []
+check = Checks(verbose=True)
 tmp = tempfile.mkdtemp(prefix="synbench_profile_tools_")
 
 if not shutil.which("socat"):
@@ -40,12 +41,6 @@ if not shutil.which("socat"):
 def run(*args, timeout=120):
     p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=timeout)
     return p.returncode, p.stdout, p.stderr
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
 
 
 def load(kind):
@@ -303,5 +298,4 @@ check(code == 1 and out.count("error: ") > 40 and "0 of " in out,
       f"probing a stopped emulator: every signal's error, exit 1: {out.strip().splitlines()[-1:]}")
 
 shutil.rmtree(tmp, ignore_errors=True)
-print(f"{(len(failures) == 0) and 'all' or len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
-sys.exit(1 if failures else 0)
+check.finish("all checks passed")

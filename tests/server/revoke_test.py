@@ -2,7 +2,7 @@
 """A revoked token (removed from DATA_DIR/tokens.json while the daemon runs) ends its open
 WebSocket session within a couple of seconds and is refused over HTTP at once; failed sign-ins
 are logged on stderr with the client's address, rate-limited (50 bad tokens: one or two lines).
-Exit 77 without python3-websocket."""
+Exit 77 without python3-websocket (ws_util.py; 1 under CI)."""
 import http.client
 import json
 import os
@@ -12,21 +12,12 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-try:
-    import websocket  # noqa: F401
-except ImportError:
-    print("skip: python3-websocket is not installed")
-    sys.exit(77)
-from ws_util import Daemon, close_code, connect, recv_until  # noqa: E402
+from checks import Checks  # noqa: E402
+from daemon import Daemon  # noqa: E402
+from ws_util import close_code, connect, recv_until  # noqa: E402
 
 BIN = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    if not cond:
-        failures.append(what)
+check = Checks(verbose=True)
 
 
 def main():
@@ -68,8 +59,7 @@ def main():
     check(1 <= len(lines) <= 2 and "127.0.0.1" in lines[0],
           "failed sign-ins logged with the client's address, rate-limited: %d lines for 51 (%s)" % (len(lines), lines[:2]))
     check(code == 0, "SIGTERM -> exit 0")
-    print("all checks passed" if not failures else "%d checks FAILED" % len(failures))
-    sys.exit(1 if failures else 0)
+    check.finish("all checks passed")
 
 
 if __name__ == "__main__":

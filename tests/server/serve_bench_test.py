@@ -42,6 +42,8 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import far_side as fs  # noqa: E402
+from checks import Checks  # noqa: E402
+from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
 
 BIN = sys.argv[1]
 LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow"]
@@ -56,18 +58,12 @@ SPEED, LOAD_NM, ANGLE = 600.0, 1.0, 50.0
 SLOW_S = 30.0
 PLAN = {"name": "estop under a sweep", "window_s": 1.0,
         "dimensions": {"speed_rpm": [SPEED], "load_Nm": [LOAD_NM], "angle_deg": [46, 50, 54, 58]}}
-failures = []
+check = Checks(verbose=True)
+failures = check.failures
 
 if not shutil.which("socat"):
     print("skip: socat is not installed (scripts/debian-packages.txt)")
     sys.exit(77)
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
-    return cond
 
 
 def note(what):
@@ -142,7 +138,8 @@ def run_link(kind, tmp):
         link = fs.rtu_link(pair.b) if pair else fs.tcp_link(emu.port)
         cfg = fs.write_bench_config(os.path.join(tmp, kind + "_bench.json"), link)
         data_dir = os.path.join(tmp, kind + "_data")
-        serve = fs.Serve(BIN, cfg, data_dir, os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
+        serve = Daemon(BIN, data_dir, ["--bench", cfg], log_path=os.path.join(tmp, kind + "_serve.log"),
+                       start_timeout_s=SLOW_S)
         status, devices = serve.request("GET", "/api/devices")
         check(status == 200 and all(d.get("backend") == "modbus" for d in devices),
               "%s: the daemon's devices are Modbus devices (%s)" % (kind, devices))
@@ -162,7 +159,7 @@ def run_link(kind, tmp):
         check(sp[0] == SPEED and abs(sp[1] - ANGLE) < 0.006 and sp[2] == LOAD_NM,
               "%s: setpoint registers when the reply arrives: speed %.1f rpm (SynRM holding 16-17 f32), angle %.2f deg (holding 18 i16 "
               "x0.01), torque %.2f N m (load holding 16-17 f32)" % (kind, sp[0], sp[1], sp[2]))
-        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
         check(spun, "%s: the shaft turns at %.0f rpm (SynRM input 16-17 f32: %.1f rpm), %s"
               % (kind, SPEED, far.speed_rpm(), fs.describe(far.states())))
         hb0 = far.heartbeats()
@@ -174,7 +171,7 @@ def run_link(kind, tmp):
         # 3. The ordered stop.
         status, body = serve.request("POST", "/api/bench/enable", {"enabled": False})
         check(status == 200, "%s: POST /api/bench/enable false -> 200 (%s)" % (kind, status))
-        ok = fs.wait_for(lambda: both(fs.DISABLED)(far), SLOW_S, 0.05)
+        ok = wait_for(lambda: both(fs.DISABLED)(far), SLOW_S, 0.05)
         check(ok, "%s: the ordered stop ends with both drives disabled: %s, %.1f rpm"
               % (kind, fs.describe(far.states()), far.speed_rpm()))
 
@@ -191,7 +188,7 @@ def run_link(kind, tmp):
             serve.request("POST", "/api/bench/reset")
             status, body = serve.request("POST", "/api/sweeps/%s/start" % sid)
         check(status == 202, "%s: POST /api/sweeps/%s/start -> 202 (%s %s)" % (kind, sid, status, str(body)[:200]))
-        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.5 * SPEED), SLOW_S, 0.05)
+        spun = wait_for(lambda: running_at(far, SPEED, 0.5 * SPEED), SLOW_S, 0.05)
         check(spun, "%s: the sweep runs the drives: %s, %.1f rpm" % (kind, fs.describe(far.states()), far.speed_rpm()))
         state = sweep_state(serve, sid)
         check(state == "running", "%s: the sweep is running when the E-stop comes (%s)" % (kind, state))
@@ -199,7 +196,7 @@ def run_link(kind, tmp):
         # 5. E-stop while it runs.
         before = far.states()
         hb_before = far.heartbeats()
-        pending = fs.PendingRequest(serve.port, serve.raw_request_bytes("POST", "/api/bench/estop"))
+        pending = PendingRequest(serve.port, serve.raw_request_bytes("POST", "/api/bench/estop"))
         t_off, relapses, beats, last, at_reply = watch_estop(far, pending, ESTOP_DEADLINE_S, STAY_S)
         reply_s = pending.answered_at - pending.sent_at if pending.answered_at else None
         note("%s: before the E-stop %s; E-stop answered %s in %s" % (
@@ -220,7 +217,7 @@ def run_link(kind, tmp):
         sup = st.get("supervisor", {}) if isinstance(st, dict) else {}
         check(sup.get("phase") == "estopped" and sup.get("tripped"),
               "%s: the daemon says estopped (%s)" % (kind, sup))
-        ended = fs.wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
+        ended = wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
         check(ended, "%s: the sweep stops running (%s)" % (kind, sweep_state(serve, sid)))
 
         # 6. The drives' own watchdog, the second line: the load drive is enabled behind the
@@ -232,7 +229,7 @@ def run_link(kind, tmp):
             t0 = time.monotonic()
             check(far.state(fs.LOAD)[0] == fs.RUNNING, "%s: the far side enables the load drive at 0 N m" % kind)
             # (A watchdog trip passes through stopping, the torque ramped to zero, to faulted.)
-            fs.wait_for(lambda: far.state(fs.LOAD)[0] in (fs.DISABLED, fs.FAULTED), WATCHDOG_MS / 1000 + 3, 0.01)
+            wait_for(lambda: far.state(fs.LOAD)[0] in (fs.DISABLED, fs.FAULTED), WATCHDOG_MS / 1000 + 3, 0.01)
             dt = time.monotonic() - t0
             end = far.states()
             tripped = end[1] == (fs.FAULTED, fs.WATCHDOG)
@@ -267,14 +264,14 @@ def run_link(kind, tmp):
         check(status == 200, "%s: POST /api/bench/enable after the reset -> 200 (%s %s)" % (kind, status, str(body)[:200]))
         check(was_off and all(s == fs.RUNNING for s, _ in now),
               "%s: both drives, disabled before, read running when the reply arrives: %s" % (kind, fs.describe(now)))
-        spun = fs.wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
+        spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
         check(was_off and spun and far.speed_setpoint_rpm() == SPEED,
               "%s: the drives, disabled before, run again at %.0f rpm: %s, %.1f rpm, setpoint register %.1f%s"
               % (kind, SPEED, fs.describe(far.states()), far.speed_rpm(), far.speed_setpoint_rpm(),
                  "" if was_off else " (they were never disabled)"))
 
         # 9. SIGTERM.
-        rc = serve.stop()
+        rc, _ = serve.stop()
         after = far.states()
         check(rc == 0, "%s: SIGTERM -> the daemon exits 0 (%s)" % (kind, rc))
         check(all(s == fs.DISABLED for s, _ in after), "%s: both drives read disabled when it has exited: %s"
@@ -377,7 +374,8 @@ def run_slow(tmp):
     serve = None
     try:
         cfg = fs.write_bench_config(os.path.join(tmp, "slow_bench.json"), fs.tcp_link(emu.port))
-        serve = fs.Serve(BIN, cfg, os.path.join(tmp, "slow_data"), os.path.join(tmp, "slow_serve.log"), start_timeout_s=SLOW_S)
+        serve = Daemon(BIN, os.path.join(tmp, "slow_data"), ["--bench", cfg],
+                       log_path=os.path.join(tmp, "slow_serve.log"), start_timeout_s=SLOW_S)
         time.sleep(1.0)  # the bench thread is now in its slow ticks
         worst = {}
         for path in ("/api/health", "/api/bench/status", "/metrics"):
@@ -413,8 +411,7 @@ def main():
                 check(False, "%s: %s" % (kind, e))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("all checks passed" if not failures else "%d checks FAILED" % len(failures))
-    sys.exit(1 if failures else 0)
+    check.finish("all checks passed")
 
 
 if __name__ == "__main__":

@@ -10,7 +10,6 @@ import http.client
 import json
 import os
 import re
-import signal
 import socket
 import stat
 import subprocess
@@ -18,42 +17,11 @@ import sys
 import tempfile
 import time
 
+from checks import Checks
+from daemon import Daemon, run_sweep, send_raw
+
 BIN = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
-
-
-class Daemon:
-    def __init__(self, data_dir):
-        self.proc = subprocess.Popen([BIN, "serve", "--listen", "127.0.0.1:0", "--data-dir", data_dir],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        line = self.proc.stdout.readline()
-        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line)
-        if not m:
-            self.proc.kill()
-            raise SystemExit("serve did not start: %r %s" % (line, self.proc.stderr.read()))
-        self.port = int(m.group(1))
-
-    def request(self, method, path, body=None, token=None, host=None, headers=None):
-        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
-        h = {"Host": host or "127.0.0.1:%d" % self.port}
-        if token:
-            h["Authorization"] = "Bearer " + token
-        if body is not None and not isinstance(body, (bytes, str)):
-            body = json.dumps(body)
-        if body is not None:
-            h["Content-Type"] = "application/json"
-        h.update(headers or {})
-        conn.request(method, path, body=body, headers=h)
-        r = conn.getresponse()
-        data = r.read()
-        conn.close()
-        return r.status, data, r
+check = Checks(verbose=False)
 
 
 def error_of(data):
@@ -66,13 +34,11 @@ def main():
     data_dir = os.path.join(tmp, "data")
     # A small sweep in the daemon's store, for the sweep routes.
     os.makedirs(data_dir)
-    plan = os.path.join(tmp, "plan.json")
-    with open(plan, "w") as f:
-        json.dump({"name": "tiny", "window_s": 0.5,
-                   "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}}, f)
-    r = subprocess.run([BIN, "sweep", plan, "--db", os.path.join(data_dir, "synbench.db")], capture_output=True, text=True)
+    r = run_sweep(BIN, {"name": "tiny", "window_s": 0.5,
+                        "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}},
+                  os.path.join(data_dir, "synbench.db"), tmp)
     check(r.returncode == 0, "tiny sweep into the data dir (%s)" % r.stderr[-300:])
-    d = Daemon(data_dir)
+    d = Daemon(BIN, data_dir)
     try:
         token_file = os.path.join(data_dir, "operator.token")
         check(os.path.exists(token_file), "first start writes operator.token")
@@ -87,10 +53,10 @@ def main():
         bad = subprocess.run([BIN, "token", "create", "--role", "admin", "--data-dir", data_dir], capture_output=True, text=True)
         check(bad.returncode == 2 and "--role" in bad.stderr, "token create --role admin: exit 2 naming --role")
 
-        status, data, _ = d.request("GET", "/api/health")
+        status, data, _ = d.http("GET", "/api/health")
         check(status == 200 and json.loads(data)["status"] == "ok", "health 200")
 
-        status, data, _ = d.request("GET", "/api/openapi.json")
+        status, data, _ = d.http("GET", "/api/openapi.json")
         check(status == 200, "openapi 200")
         doc = json.loads(data)
         check(doc["openapi"].startswith("3."), "OpenAPI 3")
@@ -105,187 +71,171 @@ def main():
             concrete = re.sub(r"\{[^}]+\}", "1", path)
             if method != "GET" and role == "viewer":
                 # Validation without side effects (POST /api/sweeps/estimate): any token reads.
-                s, _, _ = d.request(method, concrete, body={})
+                s, _, _ = d.http(method, concrete, body={})
                 check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
-                s, _, _ = d.request(method, concrete, body={}, token=viewer)
+                s, _, _ = d.http(method, concrete, body={}, token=viewer)
                 check(s in (200, 400), "%s %s with viewer -> answered (got %d)" % (method, path, s))
             elif method != "GET":
                 check(role == "operator", "%s %s needs operator" % (method, path))
-                s, data, r = d.request(method, concrete, body={})
+                s, data, r = d.http(method, concrete, body={})
                 check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
                 check(error_of(data)[0] == "unauthorized", "%s %s 401 is a JSON error" % (method, path))
                 check(r.getheader("WWW-Authenticate", "").startswith("Bearer"), "401 carries WWW-Authenticate")
-                s, _, _ = d.request(method, concrete, body={}, token="sbt_" + "0" * 64)
+                s, _, _ = d.http(method, concrete, body={}, token="sbt_" + "0" * 64)
                 check(s == 401, "%s %s with an unknown token -> 401" % (method, path))
-                s, data, _ = d.request(method, concrete, body={}, token=viewer)
+                s, data, _ = d.http(method, concrete, body={}, token=viewer)
                 check(s == 403, "%s %s with viewer -> 403 (got %d)" % (method, path, s))
                 check(error_of(data)[0] == "forbidden", "%s %s 403 is a JSON error" % (method, path))
             else:
-                s, _, _ = d.request(method, concrete, token=viewer if role != "anyone" else None)
+                s, _, _ = d.http(method, concrete, token=viewer if role != "anyone" else None)
                 check(s == 200, "%s %s as %s -> 200 (got %d)" % (method, path, role, s))
                 if role != "anyone":
-                    s, _, _ = d.request(method, concrete)
+                    s, _, _ = d.http(method, concrete)
                     check(s == 401, "%s %s without token -> 401" % (method, path))
 
         # Sweeps from the store.
-        s, data, _ = d.request("GET", "/api/sweeps", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps", token=viewer)
         sweeps = json.loads(data)
         check(s == 200 and len(sweeps) == 1 and sweeps[0]["name"] == "tiny" and sweeps[0]["points_stored"] == 2,
               "GET /api/sweeps lists the tiny sweep")
-        s, data, _ = d.request("GET", "/api/sweeps/1", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1", token=viewer)
         check(s == 200 and json.loads(data)["state"] == "completed" and "plan" in json.loads(data), "GET /api/sweeps/1")
-        s, data, _ = d.request("GET", "/api/sweeps/1/points", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/points", token=viewer)
         check(s == 200 and len(json.loads(data)) == 2 and json.loads(data)[0]["point_index"] == 0, "points as JSON")
-        s, data, r = d.request("GET", "/api/sweeps/1/points?format=csv", token=viewer)
+        s, data, r = d.http("GET", "/api/sweeps/1/points?format=csv", token=viewer)
         lines = data.decode().splitlines()
         check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("point_index")
               and len(lines) == 3, "points as CSV")
         # Pages: ?offset=&limit=, the total in X-Total-Count; without them the whole (small) sweep.
-        s, data, r = d.request("GET", "/api/sweeps/1/points", token=viewer)
+        s, data, r = d.http("GET", "/api/sweeps/1/points", token=viewer)
         check(r.getheader("X-Total-Count") == "2", "points: X-Total-Count without paging")
-        s, data, r = d.request("GET", "/api/sweeps/1/points?offset=1&limit=1", token=viewer)
+        s, data, r = d.http("GET", "/api/sweeps/1/points?offset=1&limit=1", token=viewer)
         page = json.loads(data) if s == 200 else []
         check(s == 200 and len(page) == 1 and page[0]["point_index"] == 1 and r.getheader("X-Total-Count") == "2",
               "points ?offset=1&limit=1: the second point, total 2")
-        s, data, _ = d.request("GET", "/api/sweeps/1/points?offset=5", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/points?offset=5", token=viewer)
         check(s == 200 and json.loads(data) == [], "points past the end: an empty page")
-        s, data, r = d.request("GET", "/api/sweeps/1/points?format=csv&limit=1", token=viewer)
+        s, data, r = d.http("GET", "/api/sweeps/1/points?format=csv&limit=1", token=viewer)
         check(s == 200 and len(data.decode().splitlines()) == 2, "a CSV page: header and one row")
         for q in ("limit=0", "limit=10001", "offset=-1", "limit=x", "offset=%ff"):
-            s, data, _ = d.request("GET", "/api/sweeps/1/points?" + q, token=viewer)
+            s, data, _ = d.http("GET", "/api/sweeps/1/points?" + q, token=viewer)
             check(s == 400 and error_of(data)[0] == "bad_field", "points ?%s -> 400 bad_field (got %d)" % (q, s))
         # Analysis of the stored sweep, JSON and CSV.
-        s, data, _ = d.request("GET", "/api/sweeps/1/analysis", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/analysis", token=viewer)
         an = json.loads(data)
         check(s == 200 and an["schema"] == "synbench.analysis/1", "analysis as JSON (%s)" % data[:200])
         curves = an["curves"]["entries"]
         check(len(curves) == 1 and curves[0]["speed_rpm"] == 500 and 48 <= curves[0]["mtpa"]["angle_deg"] <= 52,
               "analysis: one curve at 500 rpm, MTPA within the two angles measured (%s)" % curves[:1])
-        s, data, r = d.request("GET", "/api/sweeps/1/analysis?format=csv", token=viewer)
+        s, data, r = d.http("GET", "/api/sweeps/1/analysis?format=csv", token=viewer)
         lines = data.decode().splitlines()
         check(s == 200 and r.getheader("Content-Type").startswith("text/csv") and lines[0].startswith("estimator,pwm,speed_rpm")
               and len(lines) == 2 and lines[1].startswith("encoder,capwm,500,1,2,"), "analysis as CSV (%s)" % lines[:2])
-        s, data, _ = d.request("GET", "/api/sweeps/1/analysis?reference=nothing", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/analysis?reference=nothing", token=viewer)
         check(s == 400 and error_of(data)[1].startswith("reference"), "bad reference -> 400 naming reference")
-        s, data, _ = d.request("GET", "/api/sweeps/1/analysis?reference=ekf-rs/aspwm", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/analysis?reference=ekf-rs/aspwm", token=viewer)
         check(s == 200 and json.loads(data)["deltas"]["reference"]["estimator"] == "ekf-rs", "analysis with another reference")
         # Presets and estimates.
-        s, data, _ = d.request("GET", "/api/presets", token=viewer)
+        s, data, _ = d.http("GET", "/api/presets", token=viewer)
         presets = {p["name"]: p for p in json.loads(data)}
         check(s == 200 and set(presets) == {"thesis-grid", "iec-61800-9-2"}, "presets listed")
         check(presets["thesis-grid"]["estimate"]["points"] == 5 * 7 * 19 * 8 - 2 * 3 * 7 * 19 - 3 * 7 * 19,
               "thesis grid: 5 x 7 x 19 points per configuration, EEMF variants from 500 rpm, HFI to 300 rpm (%s)"
               % presets["thesis-grid"]["estimate"]["points"])
-        s, data, _ = d.request("POST", "/api/sweeps/estimate", token=viewer,
+        s, data, _ = d.http("POST", "/api/sweeps/estimate", token=viewer,
                                body={"dimensions": {"speed_rpm": [300, 600], "load_Nm": [1, 2], "angle_deg": {"from": 44, "to": 64, "step": 10}}})
         est = json.loads(data)
         check(s == 200 and est["points"] == 12 and est["duration_s"] > 12 and est["plan"]["dimensions"]["angle_deg"] == [44, 54, 64],
               "estimate of a 2 x 2 x 3 plan (%s)" % data[:200])
-        s, data, _ = d.request("POST", "/api/sweeps/estimate", token=viewer, body={"dimensions": {"speed_rpm": {"from": 1, "to": 2, "step": 0}}})
+        s, data, _ = d.http("POST", "/api/sweeps/estimate", token=viewer, body={"dimensions": {"speed_rpm": {"from": 1, "to": 2, "step": 0}}})
         check(s == 400 and error_of(data)[0] == "bad_plan" and "/dimensions/speed_rpm" in error_of(data)[1], "bad estimate -> 400 at the pointer")
         # Who am I, estimators, devices, profiles.
-        s, data, _ = d.request("GET", "/api/whoami", token=viewer)
+        s, data, _ = d.http("GET", "/api/whoami", token=viewer)
         check(s == 200 and json.loads(data)["role"] == "viewer" and viewer not in data.decode(), "whoami as viewer")
-        s, data, _ = d.request("GET", "/api/whoami", token=op)
+        s, data, _ = d.http("GET", "/api/whoami", token=op)
         check(json.loads(data)["role"] == "operator", "whoami as operator")
-        s, data, _ = d.request("GET", "/api/estimators", token=viewer)
+        s, data, _ = d.http("GET", "/api/estimators", token=viewer)
         est = {e["name"]: e for e in json.loads(data)}
         check(len(est) == 7 and not est["encoder"]["sensorless"] and est["eemf-lut"]["min_speed_rpm"] == 500, "estimators listed")
-        s, data, _ = d.request("GET", "/api/devices", token=viewer)
+        s, data, _ = d.http("GET", "/api/devices", token=viewer)
         check(s == 200 and {x["role"] for x in json.loads(data)} >= {"synrm", "load", "meter"}
               and json.loads(data)[0]["backend"] == "twin", "devices of the twin")
-        s, data, _ = d.request("GET", "/api/profiles", token=viewer)
+        s, data, _ = d.http("GET", "/api/profiles", token=viewer)
         profs = json.loads(data)
         check(s == 200 and len(profs) == 3 and all(p["valid"] for p in profs), "default profiles listed, valid")
         tiny = {"name": "rest", "window_s": 0.5, "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [48, 52]}}
-        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps", body=tiny, token=op)
         created = json.loads(data)
         check(s == 201 and created["state"] == "created" and created["total_points"] == 2, "POST /api/sweeps -> 201 created")
-        s, data, _ = d.request("POST", "/api/sweeps", body={"dimensions": {"speed_rpm": [-5]}}, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps", body={"dimensions": {"speed_rpm": [-5]}}, token=op)
         check(s == 400 and error_of(data)[0] == "bad_plan" and "/dimensions/speed_rpm" in error_of(data)[1],
               "bad plan -> 400 naming the JSON pointer (%s)" % data[:200])
         r = subprocess.run([BIN, "sweep", "--resume", str(created["id"]), "--db", os.path.join(data_dir, "synbench.db"), "--quiet"],
                            capture_output=True, text=True)
         check(r.returncode == 0, "a sweep created over REST runs with synbench sweep --resume")
-        s, data, _ = d.request("GET", "/api/sweeps/%d" % created["id"], token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/%d" % created["id"], token=viewer)
         check(s == 200 and json.loads(data)["state"] == "completed" and json.loads(data)["points_stored"] == 2,
               "the daemon sees the sweep completed")
         # A sweep run by the daemon's own bench, in real time.
-        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps", body=tiny, token=op)
         sid = json.loads(data)["id"]
-        s, data, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps/%d/start" % sid, token=op)
         check(s == 202, "start a sweep on the daemon -> 202 (%s)" % data[:200])
-        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         check(s == 409 and error_of(data)[0] == "sweep_running", "manual enable refused during a sweep")
-        s, data, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps/%d/start" % sid, token=op)
         check(s == 409, "a second start is refused")
         state = None
         deadline = time.time() + 60
         while time.time() < deadline:
-            _, data, _ = d.request("GET", "/api/sweeps/%d" % sid, token=viewer)
+            _, data, _ = d.http("GET", "/api/sweeps/%d" % sid, token=viewer)
             sw = json.loads(data)
             state = sw["state"]
             if state not in ("created", "running"):
                 break
             time.sleep(0.5)
         check(state == "completed" and sw["points_stored"] == 2, "the daemon's sweep completes with 2 points (%s)" % state)
-        _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+        _, data, _ = d.http("GET", "/api/bench/status", token=viewer)
         check(json.loads(data)["sweep"]["state"] == "completed", "status shows the last sweep")
-        s, data, _ = d.request("POST", "/api/sweeps", body=tiny, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps", body=tiny, token=op)
         sid = json.loads(data)["id"]
-        d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
-        s, data, _ = d.request("POST", "/api/sweeps/%d/abort" % sid, token=op)
+        d.http("POST", "/api/sweeps/%d/start" % sid, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps/%d/abort" % sid, token=op)
         check(s == 200, "abort a running sweep")
         deadline = time.time() + 30
         while time.time() < deadline:
-            _, data, _ = d.request("GET", "/api/sweeps/%d" % sid, token=viewer)
+            _, data, _ = d.http("GET", "/api/sweeps/%d" % sid, token=viewer)
             state = json.loads(data)["state"]
             if state != "running":
                 break
             time.sleep(0.3)
         check(state == "aborted", "the aborted sweep is recorded aborted (%s)" % state)
-        s, data, _ = d.request("POST", "/api/sweeps/%d/pause" % sid, token=op)
+        s, data, _ = d.http("POST", "/api/sweeps/%d/pause" % sid, token=op)
         check(s == 409 and error_of(data)[0] == "not_running", "pause of a sweep not running -> 409")
 
-        s, data, _ = d.request("GET", "/api/sweeps/99", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/99", token=viewer)
         check(s == 404 and error_of(data)[0] == "not_found", "unknown sweep -> 404")
-        s, data, _ = d.request("GET", "/api/sweeps/abc", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/abc", token=viewer)
         check(s == 400 and error_of(data)[1].startswith("id"), "bad sweep id -> 400 naming id")
-        s, data, _ = d.request("GET", "/api/sweeps/1/points?format=xml", token=viewer)
+        s, data, _ = d.http("GET", "/api/sweeps/1/points?format=xml", token=viewer)
         check(s == 400 and error_of(data)[1].startswith("format"), "bad format -> 400 naming format")
 
         # Limits and errors.
-        s, data, _ = d.request("GET", "/api/health", host="evil.example:%d" % d.port)
+        s, data, _ = d.http("GET", "/api/health", host="evil.example:%d" % d.port)
         check(s == 403 and error_of(data)[0] == "host_not_allowed", "foreign Host -> 403")
-        s, _, _ = d.request("GET", "/api/health", host="localhost:%d" % d.port)
+        s, _, _ = d.http("GET", "/api/health", host="localhost:%d" % d.port)
         check(s == 200, "Host localhost:PORT accepted")
-        s, _, _ = d.request("GET", "/api/health", host="127.0.0.1:1")
+        s, _, _ = d.http("GET", "/api/health", host="127.0.0.1:1")
         check(s == 403, "Host with another port -> 403")
         # Two Host headers (both allowed or not): 400, never a pick of one.
         for second in ("127.0.0.1:%d" % d.port, "evil.example"):
-            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
-            raw.sendall(("GET /api/health HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: %s\r\nConnection: close\r\n\r\n"
-                         % (d.port, second)).encode())
-            reply = b""
-            while True:
-                chunk = raw.recv(4096)
-                if not chunk:
-                    break
-                reply += chunk
-            raw.close()
+            reply = send_raw(d.port, ("GET /api/health HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nHost: %s\r\nConnection: close\r\n\r\n"
+                                      % (d.port, second)).encode())
             check(reply.startswith(b"HTTP/1.1 400") and b"more than one Host" in reply, "duplicate Host (%s) -> 400" % second)
         # A path or parameter that is not UTF-8: a JSON answer, never a crash.
         for path, status in (("/api/\xff", 404), ("/\xff.js", 404), ("/api/sweeps/%ff", 400), ("/api/sweeps/1/points?format=%ff", 400)):
-            raw = socket.create_connection(("127.0.0.1", d.port), timeout=10)
-            raw.sendall(b"GET " + path.encode("latin-1") + ("" " HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nAuthorization: Bearer %s\r\n"
-                                                           "Connection: close\r\n\r\n" % (d.port, viewer)).encode())
-            reply = b""
-            while True:
-                chunk = raw.recv(4096)
-                if not chunk:
-                    break
-                reply += chunk
-            raw.close()
+            reply = send_raw(d.port, b"GET " + path.encode("latin-1") + (
+                " HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nAuthorization: Bearer %s\r\nConnection: close\r\n\r\n" % (d.port, viewer)).encode())
             head, _, body = reply.partition(b"\r\n\r\n")
             try:
                 doc = json.loads(body.decode("utf-8"))
@@ -294,17 +244,17 @@ def main():
             check(head.startswith(b"HTTP/1.1 %d" % status) and doc is not None and "error" in doc,
                   "GET %r -> %d with a JSON error (got %r)" % (path, status, reply[:120]))
             check(d.proc.poll() is None, "the daemon survives GET %r" % path)
-        s, data, _ = d.request("POST", "/api/bench/setpoints", body="x" * (65 * 1024), token=op)
+        s, data, _ = d.http("POST", "/api/bench/setpoints", body="x" * (65 * 1024), token=op)
         check(s == 413 and error_of(data)[0] == "body_too_large", "body over the limit -> 413")
-        s, data, _ = d.request("POST", "/api/bench/setpoints", body='{"speed_rpm": ', token=op)
+        s, data, _ = d.http("POST", "/api/bench/setpoints", body='{"speed_rpm": ', token=op)
         check(s == 400 and error_of(data)[0] == "bad_json" and "column" in error_of(data)[1], "bad JSON -> 400 naming the position")
-        s, data, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 99999}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/setpoints", body={"speed_rpm": 99999}, token=op)
         check(s == 400 and error_of(data)[1].startswith("speed_rpm"), "out-of-range setpoint names the field")
-        s, data, _ = d.request("GET", "/api/nowhere", token=viewer)
+        s, data, _ = d.http("GET", "/api/nowhere", token=viewer)
         check(s == 404 and error_of(data)[0] == "not_found", "unknown route -> 404 JSON")
-        s, _, r = d.request("DELETE", "/api/bench/status", token=op)
+        s, _, r = d.http("DELETE", "/api/bench/status", token=op)
         check(s == 405 and r.getheader("Allow") == "GET", "wrong method -> 405 with Allow")
-        s, _, _ = d.request("GET", "/api/health", headers={"X-Big": "y" * 10000})
+        s, _, _ = d.http("GET", "/api/health", headers={"X-Big": "y" * 10000})
         check(s == 431, "header over the limit -> 431 (got %d)" % s)
 
         # Connection limit: 64 idle connections that never showed a token fill the house; the
@@ -337,31 +287,31 @@ def main():
         conn.close()
 
         # Manual mode: estimator and PWM, refused while enabled.
-        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "ekf-rs", "pwm": "aspwm"}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/mode", body={"estimator": "ekf-rs", "pwm": "aspwm"}, token=op)
         check(s == 200 and json.loads(data)["mode"] == {"estimator": "ekf-rs", "pwm": "aspwm"}, "mode -> ekf-rs/aspwm")
-        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "magic"}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/mode", body={"estimator": "magic"}, token=op)
         check(s == 400 and error_of(data)[1].startswith("estimator"), "unknown estimator -> 400 naming estimator")
-        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "encoder", "pwm": "capwm"}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/mode", body={"estimator": "encoder", "pwm": "capwm"}, token=op)
         check(s == 200, "mode back to encoder/capwm")
         # The twin follows the operator's setpoint in real time.
-        s, _, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 400, "load_Nm": 0.5, "angle_deg": 50}, token=op)
+        s, _, _ = d.http("POST", "/api/bench/setpoints", body={"speed_rpm": 400, "load_Nm": 0.5, "angle_deg": 50}, token=op)
         check(s == 200, "setpoints as operator -> 200")
-        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         check(s == 200, "enable -> 200 (%s)" % data)
         speed = 0.0
         deadline = time.time() + 15
         while time.time() < deadline:
-            _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+            _, data, _ = d.http("GET", "/api/bench/status", token=viewer)
             st = json.loads(data)
             speed = st["synrm"]["speed_rpm"] if st["synrm"] else 0.0
             if abs(speed - 400) < 20:
                 break
             time.sleep(0.2)
         check(abs(speed - 400) < 20, "twin speed follows the setpoint (%.1f rpm)" % speed)
-        s, data, _ = d.request("POST", "/api/bench/mode", body={"pwm": "aspwm"}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/mode", body={"pwm": "aspwm"}, token=op)
         check(s == 409 and error_of(data)[0] == "bench_enabled", "mode change refused while enabled")
         check(st["synrm"]["pos_err_deg"] is None, "no live position error with the encoder")
-        s, data, _ = d.request("GET", "/metrics")
+        s, data, _ = d.http("GET", "/metrics")
         check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
         check("synbench_ws_clients 0" in data.decode() and "synbench_ws_dropped_total 0" in data.decode(),
               "metrics counts WebSocket clients and drops")
@@ -370,34 +320,34 @@ def main():
         # but may always E-stop.
         op2 = subprocess.run([BIN, "token", "create", "--role", "operator", "--data-dir", data_dir],
                              capture_output=True, text=True).stdout.strip()
-        s, data, _ = d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 100}, token=op2)
+        s, data, _ = d.http("POST", "/api/bench/setpoints", body={"speed_rpm": 100}, token=op2)
         check(s == 409 and error_of(data)[0] == "locked", "another operator is refused while op holds the lock")
-        s, data, _ = d.request("GET", "/api/bench/lock", token=viewer)
+        s, data, _ = d.http("GET", "/api/bench/lock", token=viewer)
         check(s == 200 and json.loads(data)["holder"], "GET /api/bench/lock names the holder")
         check(op not in data.decode(), "the lock holder label is not the token")
 
-        s, data, _ = d.request("POST", "/api/bench/estop", token=op2)
+        s, data, _ = d.http("POST", "/api/bench/estop", token=op2)
         st = json.loads(data)
         check(s == 200 and st["supervisor"]["phase"] == "estopped" and st["supervisor"]["tripped"], "E-stop latches")
-        s, data, _ = d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         check(s == 409 and error_of(data)[0] == "tripped", "enable refused while tripped")
-        s, _, _ = d.request("POST", "/api/bench/reset", token=op)
+        s, _, _ = d.http("POST", "/api/bench/reset", token=op)
         check(s == 200, "reset after E-stop")
-        s, _, _ = d.request("DELETE", "/api/bench/lock", token=op2)
+        s, _, _ = d.http("DELETE", "/api/bench/lock", token=op2)
         check(s == 409, "op2 cannot release op's lock")
-        s, _, _ = d.request("DELETE", "/api/bench/lock", token=op)
+        s, _, _ = d.http("DELETE", "/api/bench/lock", token=op)
         check(s == 200, "op releases the lock")
 
         # Sensorless: the live telemetry carries the estimator's position error.
         # (EKF-BASIC with ASPWM, the thesis configuration.)
-        s, data, _ = d.request("POST", "/api/bench/mode", body={"estimator": "ekf-basic", "pwm": "aspwm"}, token=op)
+        s, data, _ = d.http("POST", "/api/bench/mode", body={"estimator": "ekf-basic", "pwm": "aspwm"}, token=op)
         check(s == 200, "mode ekf-basic (%s)" % data[:200])
-        d.request("POST", "/api/bench/setpoints", body={"speed_rpm": 500, "load_Nm": 1.0, "angle_deg": 50}, token=op)
-        d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        d.http("POST", "/api/bench/setpoints", body={"speed_rpm": 500, "load_Nm": 1.0, "angle_deg": 50}, token=op)
+        d.http("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         errs = []
         deadline = time.time() + 15
         while time.time() < deadline and len(errs) < 5:
-            _, data, _ = d.request("GET", "/api/bench/status", token=viewer)
+            _, data, _ = d.http("GET", "/api/bench/status", token=viewer)
             st = json.loads(data)
             if st["synrm"] and abs(st["synrm"]["speed_rpm"] - 500) < 25:
                 errs.append(st["synrm"]["pos_err_deg"])
@@ -405,40 +355,27 @@ def main():
         check(len(errs) == 5 and all(e is not None and abs(e) < 10 for e in errs),
               "EKF-BASIC at 500 rpm: live position error within 10 deg (%s)" % errs)
         # Run again, then SIGTERM: ordered stop, exit 0.
-        d.request("POST", "/api/bench/enable", body={"enabled": True}, token=op)
+        d.http("POST", "/api/bench/enable", body={"enabled": True}, token=op)
         time.sleep(1)
-        d.proc.send_signal(signal.SIGTERM)
-        try:
-            rc = d.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            d.proc.kill()
-            rc = -1
+        rc, err = d.stop()
         check(rc == 0, "SIGTERM -> exit 0 (got %s)" % rc)
-        err = d.proc.stderr.read()
         check(op not in err.split("first start")[-1].split("\n", 1)[-1], "the token is logged only at first start")
         check(viewer not in err, "a created token is never logged")
     finally:
-        if d.proc.poll() is None:
-            d.proc.kill()
-            d.proc.wait()
+        d.kill()
 
     # SIGTERM during a sweep: the sweep is aborted with its committed points kept, exit 0.
     data_dir2 = os.path.join(tmp, "data2")
-    d = Daemon(data_dir2)
+    d = Daemon(BIN, data_dir2)
     try:
         op = open(os.path.join(data_dir2, "operator.token")).read().strip()
-        s, data, _ = d.request("POST", "/api/sweeps", token=op, body={
+        s, data, _ = d.http("POST", "/api/sweeps", token=op, body={
             "preset": "thesis-grid", "dimensions": {"configurations": [{"estimator": "encoder", "pwm": "capwm"}]}})
         sid = json.loads(data)["id"]
-        s, _, _ = d.request("POST", "/api/sweeps/%d/start" % sid, token=op)
+        s, _, _ = d.http("POST", "/api/sweeps/%d/start" % sid, token=op)
         check(s == 202, "start the thesis grid")
         time.sleep(3)
-        d.proc.send_signal(signal.SIGTERM)
-        try:
-            rc = d.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            d.proc.kill()
-            rc = -1
+        rc, _ = d.stop()
         check(rc == 0, "SIGTERM during a sweep -> exit 0 (got %s)" % rc)
         import sqlite3
         con = sqlite3.connect(os.path.join(data_dir2, "synbench.db"))
@@ -446,18 +383,13 @@ def main():
         con.close()
         check(state == "aborted", "the interrupted sweep is recorded aborted (%s)" % state)
     finally:
-        if d.proc.poll() is None:
-            d.proc.kill()
-            d.proc.wait()
+        d.kill()
 
     # Bad flags.
     r = subprocess.run([BIN, "serve", "--listen", "nonsense"], capture_output=True, text=True)
     check(r.returncode == 2 and "--listen" in r.stderr, "serve --listen nonsense: exit 2 naming --listen")
 
-    if failures:
-        print("%d failure(s)" % len(failures))
-        sys.exit(1)
-    print("serve test ok")
+    check.finish("serve test ok")
 
 
 if __name__ == "__main__":

@@ -8,60 +8,21 @@ marked aborted at the daemon's start. Standard library only.
 
 usage: storage_test.py path/to/synbench
 """
-import http.client
 import json
 import os
 import re
 import shutil
 import sqlite3
-import stat
 import subprocess
 import sys
 import tempfile
 import time
 
+from checks import Checks
+from daemon import Daemon, run_sweep
+
 BIN = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
-
-
-class Daemon:
-    def __init__(self, data_dir):
-        self.proc = subprocess.Popen([BIN, "serve", "--listen", "127.0.0.1:0", "--data-dir", data_dir],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        line = self.proc.stdout.readline()
-        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line)
-        if not m:
-            self.proc.kill()
-            raise SystemExit("serve did not start: %r %s" % (line, self.proc.stderr.read()))
-        self.port = int(m.group(1))
-        self.token = open(os.path.join(data_dir, "operator.token")).read().strip()
-
-    def request(self, method, path, body=None):
-        conn = http.client.HTTPConnection("127.0.0.1", self.port, timeout=10)
-        h = {"Host": "127.0.0.1:%d" % self.port, "Authorization": "Bearer " + self.token}
-        if body is not None:
-            body = json.dumps(body)
-            h["Content-Type"] = "application/json"
-        conn.request(method, path, body=body, headers=h)
-        r = conn.getresponse()
-        data = r.read()
-        conn.close()
-        return r.status, json.loads(data) if data else None
-
-    def stop(self):
-        self.proc.terminate()
-        try:
-            self.proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
-        return self.proc.returncode, self.proc.stderr.read()
+check = Checks(verbose=False)
 
 
 def serve_exits(data_dir):
@@ -72,18 +33,16 @@ def serve_exits(data_dir):
 
 
 def tiny_sweep(db, tmp):
-    plan = os.path.join(tmp, "plan.json")
-    with open(plan, "w") as f:
-        json.dump({"name": "tiny", "window_s": 0.2,
-                   "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 48, 52, 56]}}, f)
-    r = subprocess.run([BIN, "sweep", plan, "--db", db, "--quiet"], capture_output=True, text=True)
+    plan = {"name": "tiny", "window_s": 0.2,
+            "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 48, 52, 56]}}
+    r = run_sweep(BIN, plan, db, tmp, "--quiet")
     check(r.returncode == 0, "a tiny sweep into %s (%s)" % (db, r.stderr[-300:]))
 
 
 def deleted_during_sweep(tmp):
     data_dir = os.path.join(tmp, "deleted")
     db = os.path.join(data_dir, "synbench.db")
-    d = Daemon(data_dir)
+    d = Daemon(BIN, data_dir)
     try:
         s, body = d.request("POST", "/api/sweeps", {
             "name": "doomed", "window_s": 0.3,
@@ -194,7 +153,7 @@ def left_running(tmp):
     c.execute("DELETE FROM points WHERE point_index = 3")
     c.commit()
     c.close()
-    d = Daemon(data_dir)
+    d = Daemon(BIN, data_dir)
     try:
         s, body = d.request("GET", "/api/sweeps/1")
         check(s == 200 and body["state"] == "aborted", "a sweep left running is aborted at start (%s)" % body)
@@ -238,10 +197,7 @@ def main():
         read_only(tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    if failures:
-        print("%d failure(s)" % len(failures))
-        sys.exit(1)
-    print("storage_test: all passed")
+    check.finish("storage_test: all passed")
 
 
 if __name__ == "__main__":

@@ -13,15 +13,11 @@ import sys
 import tempfile
 import time
 
+from checks import Checks
+
 BIN = sys.argv[1]
 CRASH_RUNS = int(os.environ.get("SYNBENCH_SWEEP_CRASH_RUNS", "20"))
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    if not cond:
-        failures.append(what)
+check = Checks(verbose=True)
 
 
 def run(*args, timeout=600):
@@ -179,5 +175,4 @@ for load in (1.0, 2.0, 3.0):
     check(a is not None and all(a[t]["delta_pdcm_W"] < -0.3 for t in ("mtpa", "me")),
           f"{load} N m: ASPWM lowers P_dcM ({a and {t: round(a[t]['delta_pdcm_W'], 2) for t in ('mtpa', 'me')}})")
 
-print(f"{'all' if not failures else len(failures)} {'checks passed' if not failures else 'checks FAILED'}")
-sys.exit(1 if failures else 0)
+check.finish("all checks passed")

@@ -17,18 +17,12 @@ import sys
 import tempfile
 import time
 
-from ws_util import Daemon, close_code, connect, raw_request, recv_until, upgrade_lines, websocket
+from checks import Checks
+from daemon import Daemon, raw_request, upgrade_lines
+from ws_util import close_code, connect, recv_until, websocket
 
 BIN = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL:", what)
-    else:
-        print("ok:", what)
+check = Checks(verbose=True)
 
 
 def http_get(d, path, method="GET", host=None, headers=None):
@@ -371,10 +365,7 @@ def main():
     r = subprocess.run([BIN, "serve", "--allow-origin", "evil.example/path"], capture_output=True, text=True)
     check(r.returncode == 2 and "--allow-origin" in r.stderr, "a bad --allow-origin: exit 2 naming the flag")
 
-    if failures:
-        print("%d failure(s)" % len(failures))
-        sys.exit(1)
-    print("ws test ok")
+    check.finish("ws test ok")
 
 
 if __name__ == "__main__":

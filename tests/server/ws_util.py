@@ -1,12 +1,13 @@
-"""Helpers shared by the WebSocket, static-file and perf tests of `synbench serve`: a daemon on
-a free loopback port, tokens, raw HTTP and the websocket-client module (Debian's
-python3-websocket; a pyenv interpreter is pointed at the system's dist-packages)."""
+"""WebSocket helpers for the tests and benchmarks of `synbench serve` (the daemon itself, tokens
+and raw HTTP: daemon.py): the websocket-client module (Debian's python3-websocket; a pyenv
+interpreter is pointed at the system's dist-packages; exit 77, skipped, without it), a connection
+signed in, messages until one matches, the server's close code, a client that stalls and one
+that keeps reading telemetry."""
 import json
 import os
-import re
 import socket
-import subprocess
 import sys
+import threading
 import time
 
 try:
@@ -19,85 +20,6 @@ except ImportError:
         # CI installs it (scripts/debian-packages.txt): there a missing module is a failure.
         print("SKIP: python3-websocket is not installed")
         sys.exit(1 if os.environ.get("CI") else 77)
-
-
-class Daemon:
-    def __init__(self, binary, data_dir, extra_args=(), env=None):
-        self.data_dir = data_dir
-        self.binary = binary
-        self.proc = subprocess.Popen([binary, "serve", "--listen", "127.0.0.1:0", "--data-dir", data_dir, *extra_args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-        line = self.proc.stdout.readline()
-        m = re.match(r"listening on http://127\.0\.0\.1:(\d+)", line)
-        if not m:
-            self.proc.kill()
-            raise SystemExit("serve did not start: %r %s" % (line, self.proc.stderr.read()))
-        self.port = int(m.group(1))
-        self.host = "127.0.0.1:%d" % self.port
-        self.url = "ws://%s/ws" % self.host
-        self.operator = open(os.path.join(data_dir, "operator.token")).read().strip()
-
-    def token(self, role):
-        r = subprocess.run([self.binary, "token", "create", "--role", role, "--data-dir", self.data_dir],
-                           capture_output=True, text=True, check=True)
-        return r.stdout.strip()
-
-    def rss_kB(self):
-        with open("/proc/%d/status" % self.proc.pid) as f:
-            for line in f:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1])
-        return 0
-
-    def stop(self, read_stderr=True):
-        """SIGTERM, wait; returns (exit status, stderr or "" when someone else reads it)."""
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        return self.proc.returncode, self.proc.stderr.read() if read_stderr else ""
-
-
-def raw_request(port, lines, timeout=5):
-    """Sends a raw HTTP/1.1 request (a list of lines, without the blank line); returns
-    (status, headers dict lower-cased, body bytes read so far)."""
-    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
-    s.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
-    data = b""
-    while b"\r\n\r\n" not in data:
-        chunk = s.recv(65536)
-        if not chunk:
-            break
-        data += chunk
-    head, _, body = data.partition(b"\r\n\r\n")
-    status_line, *header_lines = head.decode(errors="replace").split("\r\n")
-    headers = {}
-    for h in header_lines:
-        k, _, v = h.partition(":")
-        headers[k.strip().lower()] = v.strip()
-    length = int(headers.get("content-length", "0") or 0)
-    while len(body) < length:
-        chunk = s.recv(65536)
-        if not chunk:
-            break
-        body += chunk
-    s.close()
-    parts = status_line.split(" ")
-    return (int(parts[1]) if len(parts) > 1 and parts[1].isdigit() else 0), headers, body
-
-
-def upgrade_lines(host, origin=None, path="/ws"):
-    lines = ["GET %s HTTP/1.1" % path]
-    if host is not None:
-        lines.append("Host: " + host)
-    lines += ["Upgrade: websocket", "Connection: Upgrade", "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
-              "Sec-WebSocket-Version: 13"]
-    if origin is not None:
-        lines.append("Origin: " + origin)
-    return lines
 
 
 def connect(daemon, token=None, timeout=10, **kw):
@@ -144,3 +66,45 @@ def close_code(ws, timeout_s=15):
     except (websocket.WebSocketConnectionClosedException, ConnectionError, OSError):
         return None
     return None
+
+
+def stalled_client(daemon, token, rate_hz=50):
+    """A client that subscribes to telemetry at rate_hz and to events, then reads nothing more: its
+    receive buffer is a few KiB, so the daemon's side of the connection fills quickly."""
+    ws, hello = connect(daemon, token, sockopt=((socket.SOL_SOCKET, socket.SO_RCVBUF, 4096),))
+    ws.send(json.dumps({"op": "subscribe", "channel": "telemetry", "rate_hz": rate_hz}))
+    ws.send(json.dumps({"op": "subscribe", "channel": "events"}))
+    recv_until(ws, lambda m: m["type"] == "state")
+    return ws, hello
+
+
+class TelemetryReader:
+    """A client that reads telemetry at rate_hz on a thread of its own. times: the arrival of each
+    message (time.time()); errors: what ended the connection, if anything did."""
+
+    def __init__(self, daemon, token, rate_hz):
+        self.ws, _ = connect(daemon, token)
+        self.ws.send(json.dumps({"op": "subscribe", "channel": "telemetry", "rate_hz": rate_hz}))
+        recv_until(self.ws, lambda m: m["type"] == "telemetry")
+        self.times, self.errors = [], []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._read, daemon=True)
+        self._thread.start()
+
+    def _read(self):
+        self.ws.settimeout(1.0)
+        while not self._stop.is_set():
+            try:
+                m = json.loads(self.ws.recv())
+            except websocket.WebSocketTimeoutException:
+                continue
+            except Exception as e:  # noqa: BLE001 - the caller reports it
+                self.errors.append(str(e))
+                return
+            if m["type"] == "telemetry":
+                self.times.append(time.time())
+
+    def stop(self):
+        self._stop.set()
+        self._thread.join(timeout=3)
+        self.ws.close()
