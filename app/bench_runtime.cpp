@@ -5,7 +5,7 @@
 #include "app/plan_needs.hpp"
 #include "bench/load_ramp.hpp"
 #include "drivers/error.hpp"
-#include "drivers/number_text.hpp"
+#include "drivers/profile/number_format.hpp"
 
 namespace synbench::app {
 

@@ -14,6 +14,7 @@
 
 #include "drivers/bench_check.hpp"
 #include "drivers/profile/device_profile.hpp"
+#include "drivers/profile/number_format.hpp"
 #include "drivers/profile/profile_dir.hpp"
 #include "emulator/modbus/fault_injector.hpp"
 #include "emulator/modbus/rtu_server.hpp"
@@ -90,15 +91,9 @@ std::atomic<bool> g_cut{false};
 extern "C" void on_stop_signal(int) { g_stop = true; }
 extern "C" void on_cut_signal(int) { g_cut = true; }
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 double percent(const Args& a, const std::string& flag) {
   const double v = a.number(flag).value_or(0.0);
-  if (v < 0 || v > 100) throw UsageError(flag, fmt(v) + " is outside [0, 100] %");
+  if (v < 0 || v > 100) throw UsageError(flag, drivers::format_number(v) + " is outside [0, 100] %");
   return v;
 }
 
@@ -192,7 +187,7 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (auto b = a.number("--baud")) {
       unsigned speed = 0;
       if (*b != std::floor(*b) || !emulator::baud_constant(static_cast<int>(*b), speed))
-        throw UsageError("--baud", fmt(*b) + " is not a supported baud rate (1200..921600)");
+        throw UsageError("--baud", drivers::format_number(*b) + " is not a supported baud rate (1200..921600)");
       serial.baud = static_cast<int>(*b);
     }
     if (auto p = a.text("--parity")) {
@@ -203,7 +198,7 @@ int emulate_command(const std::vector<std::string>& argv) {
     }
     time_scale = a.number("--time-scale").value_or(1.0);
     if (!(time_scale > 0) || time_scale > 1000)
-      throw UsageError("--time-scale", fmt(time_scale) + " is outside (0, 1000]");
+      throw UsageError("--time-scale", drivers::format_number(time_scale) + " is outside (0, 1000]");
     if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
     const auto dir = a.text("--profiles");
     const auto bench = a.text("--bench");
@@ -216,21 +211,21 @@ int emulate_command(const std::vector<std::string>& argv) {
       config.sim.seed_int = static_cast<int>(*seed);
     }
     if (auto udc = a.number("--udc-V")) {
-      if (*udc < 100 || *udc > 800) throw UsageError("--udc-V", fmt(*udc) + " is outside [100, 800] V");
+      if (*udc < 100 || *udc > 800) throw UsageError("--udc-V", drivers::format_number(*udc) + " is outside [100, 800] V");
       config.scale_bus_to(*udc);
     }
     if (auto t = a.number("--temp-C")) {
       if (*t < -40 || *t >= config.firmware.overtemp_trip_C)
-        throw UsageError("--temp-C", fmt(*t) + " is outside [-40, " + fmt(config.firmware.overtemp_trip_C) + ") degC");
+        throw UsageError("--temp-C", drivers::format_number(*t) + " is outside [-40, " + drivers::format_number(config.firmware.overtemp_trip_C) + ") degC");
       config.thermal.initial_C = *t;
     }
     if (auto d = a.number("--duration-s")) {
-      if (!(*d > 0)) throw UsageError("--duration-s", fmt(*d) + " must be positive");
+      if (!(*d > 0)) throw UsageError("--duration-s", drivers::format_number(*d) + " must be positive");
       duration_s = *d;
     }
     if (auto ms = a.number("--watchdog-timeout-ms")) {
       if (*ms < 1 || *ms > 600000)
-        throw UsageError("--watchdog-timeout-ms", fmt(*ms) + " is outside [1, 600000] ms");
+        throw UsageError("--watchdog-timeout-ms", drivers::format_number(*ms) + " is outside [1, 600000] ms");
       watchdog_s = *ms / 1000;
     }
     faults.delay_pct = percent(a, "--fault-delay-pct");
@@ -240,11 +235,11 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (faults.delay_pct + faults.drop_pct + faults.exception_pct + faults.corrupt_pct > 100)
       throw UsageError("--fault-delay-pct", "the fault percentages add up to more than 100");
     if (auto ms = a.number("--fault-delay-ms")) {
-      if (*ms < 1 || *ms > 60000) throw UsageError("--fault-delay-ms", fmt(*ms) + " is outside [1, 60000] ms");
+      if (*ms < 1 || *ms > 60000) throw UsageError("--fault-delay-ms", drivers::format_number(*ms) + " is outside [1, 60000] ms");
       faults.delay_s = *ms / 1000;
     }
     if (auto s = a.number("--fault-cut-s")) {
-      if (!(*s > 0) || *s > 3600) throw UsageError("--fault-cut-s", fmt(*s) + " is outside (0, 3600] s");
+      if (!(*s > 0) || *s > 3600) throw UsageError("--fault-cut-s", drivers::format_number(*s) + " is outside (0, 3600] s");
       cut_s = *s;
     }
     if (auto seed = a.number("--fault-seed")) {

@@ -10,6 +10,7 @@
 #include "bench/point_procedure.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "drivers/bench_config.hpp"
+#include "drivers/profile/number_format.hpp"
 #include "emulator/firmware/estimators/factory.hpp"
 #include "emulator/twin_bench.hpp"
 #include "emulator/twin_config_schema.hpp"
@@ -73,12 +74,6 @@ double required(const Args& a, const std::string& flag) {
   return *v;
 }
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 int point_command(const std::vector<std::string>& argv) {
@@ -108,30 +103,30 @@ int point_command(const std::vector<std::string>& argv) {
     req.window_s = a.number("--window-s").value_or(1.0);
 
     if (req.speed_rpm <= 0 || req.speed_rpm > config.firmware.max_speed_rpm)
-      throw UsageError("--speed-rpm", fmt(req.speed_rpm) + " is outside (0, " +
-                                          fmt(config.firmware.max_speed_rpm) +
+      throw UsageError("--speed-rpm", drivers::format_number(req.speed_rpm) + " is outside (0, " +
+                                          drivers::format_number(config.firmware.max_speed_rpm) +
                                           "] rpm (firmware.max_speed_rpm)");
     const double load_max = 1.5 * config.load.pole_pairs * config.load.psi_pm_Wb *
                             config.load.current_limit_A;
     if (req.load_Nm < 0 || req.load_Nm > load_max)
-      throw UsageError("--load-Nm", fmt(req.load_Nm) + " is outside [0, " + fmt(load_max) +
+      throw UsageError("--load-Nm", drivers::format_number(req.load_Nm) + " is outside [0, " + drivers::format_number(load_max) +
                                         "] N m (the load drive's current limit)");
     if (req.angle_deg <= 0 || req.angle_deg >= 90)
-      throw UsageError("--angle-deg", fmt(req.angle_deg) + " is outside (0, 90) deg");
+      throw UsageError("--angle-deg", drivers::format_number(req.angle_deg) + " is outside (0, 90) deg");
     if (req.window_s <= 0 || req.window_s > 3600)
-      throw UsageError("--window-s", fmt(req.window_s) + " is outside (0, 3600] s");
+      throw UsageError("--window-s", drivers::format_number(req.window_s) + " is outside (0, 3600] s");
     if (auto avail = emulator::firmware::make_estimator(req.estimator, config); avail.error)
       throw UsageError("--estimator", "'" + std::string(drivers::name(req.estimator)) +
                                           "' is not available in the twin yet");
     if (auto udc = a.number("--udc-V")) {
       if (*udc < 100 || *udc > 800)
-        throw UsageError("--udc-V", fmt(*udc) + " is outside [100, 800] V");
+        throw UsageError("--udc-V", drivers::format_number(*udc) + " is outside [100, 800] V");
       config.scale_bus_to(*udc);
     }
     if (auto t = a.number("--temp-C")) {
       if (*t < -40 || *t >= config.firmware.overtemp_trip_C)
-        throw UsageError("--temp-C", fmt(*t) + " is outside [-40, " +
-                                         fmt(config.firmware.overtemp_trip_C) +
+        throw UsageError("--temp-C", drivers::format_number(*t) + " is outside [-40, " +
+                                         drivers::format_number(config.firmware.overtemp_trip_C) +
                                          ") degC (firmware.overtemp_trip_C)");
       config.thermal.initial_C = *t;
     }

@@ -4,7 +4,7 @@
 #include "server/http/info_routes.hpp"
 
 #include "drivers/json_file.hpp"
-#include "drivers/number_text.hpp"
+#include "drivers/profile/number_format.hpp"
 
 #include <chrono>
 #include <cmath>

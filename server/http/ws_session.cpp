@@ -10,7 +10,7 @@
 #include <boost/asio/post.hpp>
 
 #include "drivers/json_file.hpp"
-#include "drivers/number_text.hpp"
+#include "drivers/profile/number_format.hpp"
 #include "drivers/utf8.hpp"
 #include "server/http/api_routes.hpp"
 
