@@ -174,9 +174,12 @@ else:
 def trip_and_reset(round_no):
     """A point whose master is frozen mid-window past the watchdog: fault unknown (code 6), the
     drives disabled and faulted on the far side, then `bench reset` and a point that completes."""
-    # A 20 s window (1 s of wall time at 20x) so the freeze lands inside it: the point settles in
-    # about 3-4 s of twin time (0.2 s wall) first.
-    p = subprocess.Popen([BIN, "point", *POINT, "--window-s", "20", "--bench", tcp],
+    # A 60 s window (3 s of wall time at 20x) so the freeze lands inside it and the window is still
+    # open when the master resumes: the point settles in about 3-4 s of twin time (0.2 s wall),
+    # is frozen at about 12 s and resumes at about 32 s. (With a 20 s window the master resumes
+    # past the window's end and closes it with the samples from before the freeze: see the
+    # report of this test's commit.)
+    p = subprocess.Popen([BIN, "point", *POINT, "--window-s", "60", "--bench", tcp],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(0.6)
     running = far.input(UNIT["synrm_drive"], STATUS)[0] & 0xB
@@ -192,6 +195,7 @@ def trip_and_reset(round_no):
         p.kill()
         out, err = p.communicate()
     how = f"trip {round_no}"
+    check(not out.strip(), f"{how}: no record for a point that faulted mid-window: {out.strip()[:600]}")
     check(running == 3, f"{how}: the SynRM drive ran (status bits {running}) when the master froze")
     # 2 N m of braking is -20.0 % of 10 N m of motoring torque: -200 counts (0xFF38) on the wire.
     check(torque_counts == 0x10000 - 200, f"{how}: far side, the load drive's torque setpoint in the vendor's "
