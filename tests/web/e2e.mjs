@@ -101,8 +101,10 @@ try {
   check(await until(async () => (await text(page, '#p-title')).includes('e2e twin sweep'), 10000),
     `the progress view shows the new sweep (${await text(page, '#p-title')})`);
   let midShot = false;
+  let etaSeen = null;  // the daemon's ETA (eta_s on the socket): the page computes none of its own
   const done = await until(async () => {
     const pct = Number(await attr(page, '#p-pct', 'data-pct'));
+    if (!etaSeen && pct > 0 && pct < 100) etaSeen = (await text(page, '#p-line')).match(/ETA (\d[^·]*)/)?.[1] ?? null;
     if (!midShot && pct >= 25 && pct <= 85 && Number(await attr(page, '[data-chart="p-map"]', 'data-points')) > 0) {
       midShot = true;
       await shot(page, artifacts, '04-progress-filling');
@@ -111,6 +113,7 @@ try {
   }, 150000, 500);
   check(done, `progress reaches 100 % and the sweep completes (${((Date.now() - started) / 1000).toFixed(0)} s)`);
   check(midShot, 'the efficiency map fills in while the sweep runs');
+  check(etaSeen, `the progress line shows the daemon's ETA while the sweep runs (${etaSeen})`);
   check(await until(async () => (await attr(page, '#p-cells', 'data-done')) === '12', 5000), 'every per-point cell is measured');
   const mapPts = await until(async () => { const n = Number(await attr(page, '[data-chart="p-map"]', 'data-points')); return n >= 4 ? n : null; }, 10000);
   check(mapPts >= 4, `the progress efficiency map has a value in every (speed, load) cell (${mapPts})`);

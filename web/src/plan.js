@@ -53,42 +53,6 @@ export function expandPlan(plan) {
   return out;
 }
 
-// Same model as bench::estimate (docs/sweep-plan.md, "Bench-time estimate").
-export function estimateLocal(plan) {
-  const d = plan.dimensions || {};
-  const gate = plan.gate || {};
-  // The gate needs its span of (averaged) samples before it can pass; a configuration's
-  // gate_average_s replaces the plan's.
-  const perPoint = (c) => Math.max(gate.min_settle_s ?? 0.5,
-    (gate.span_s ?? 0.5) + (c?.gate_average_s ?? gate.average_s ?? 0)) + 1 + (plan.window_s ?? 1);
-  const configs = d.configurations?.length ? d.configurations : [{ estimator: 'encoder', pwm: 'capwm' }];
-  let pts;
-  if (plan.mode === 'adaptive') {
-    const speeds = d.operating_points ? d.operating_points.map((p) => p.speed_rpm) : values(d.speed_rpm);
-    const nLoads = d.operating_points ? 1 : values(d.load_Nm).length;
-    const evals = plan.adaptive?.max_evaluations ?? 7;
-    let n = 0, t = 0;
-    for (const c of configs) {
-      const k = speeds.filter((s) => s >= (c.min_speed_rpm ?? 0) && s <= (c.max_speed_rpm ?? Infinity)).length * nLoads * evals;
-      n += k;
-      t += k * perPoint(c);
-    }
-    return { points: n, duration_s: t, upper_bound: true };
-  }
-  pts = expandPlan(plan);
-  let t = 0;
-  for (const p of pts) t += perPoint(configs.find((c) => c.estimator === p.estimator && c.pwm === p.pwm));
-  let prev = { speed_rpm: 0, load_Nm: 0, cfg: null };
-  for (const p of pts) {
-    t += Math.abs(p.speed_rpm - prev.speed_rpm) / 1000 + Math.abs(p.load_Nm - prev.load_Nm) / 10;
-    const cfg = `${p.estimator}/${p.pwm}`;
-    if (prev.cfg && cfg !== prev.cfg) t += 10;
-    prev = { ...p, cfg };
-  }
-  t += prev.speed_rpm / 1000 + prev.load_Nm / 10;
-  return { points: pts.length, duration_s: t, upper_bound: false };
-}
-
 export function fmtDuration(s) {
   if (s == null || !Number.isFinite(s)) return '–';
   s = Math.round(s);

@@ -1,7 +1,7 @@
 // Results view: one sweep's analysis drawn as the thesis draws it, with exports.
 import { api, download, saveBlob } from '../api.js';
 import { ChartCard } from '../charts.js';
-import { analyzeClient, analysisConfigs } from '../analysis.js';
+import { analysisConfigs } from '../analysis_configs.js';
 import { effMapOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
 import { escapeHtml } from './live.js';
 
@@ -63,16 +63,7 @@ export class ResultsView {
     $('#r-summary').textContent = 'loading…';
     try {
       const points = await api('GET', `/api/sweeps/${id}/points`);
-      let analysis = null;
-      this.analysisFromDaemon = true;
-      try { analysis = await api('GET', `/api/sweeps/${id}/analysis${this.refQuery()}`, undefined, { quiet401: true }); } catch (e) {
-        if (e.status !== 404 && e.status !== 405) throw e;
-      }
-      if (!analysis) {
-        this.analysisFromDaemon = false;
-        const [estimator, pwm] = ($('#r-ref').value || 'encoder/capwm').split('/');
-        analysis = analyzeClient(points, { estimator, pwm });
-      }
+      const analysis = await api('GET', `/api/sweeps/${id}/analysis${this.refQuery()}`, undefined, { quiet401: true });
       if (id !== this.sweepId) return;
       this.points = points;
       this.analysis = analysis;
@@ -80,8 +71,7 @@ export class ResultsView {
       this.draw();
       const p = analysis.points || {};
       $('#r-summary').textContent = `Sweep #${id}: ${p.records ?? points.length} points, ${p.used ?? '?'} used`
-        + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`
-        + `${this.analysisFromDaemon ? '' : ' · analysis computed in the browser (the daemon has no /analysis route)'}`;
+        + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`;
     } catch (e) {
       $('#r-summary').textContent = `cannot load sweep ${id}: ${e.message}`;
     }

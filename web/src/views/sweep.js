@@ -3,8 +3,7 @@
 // filling in as points complete).
 import { api, ApiError } from '../api.js';
 import { ChartCard } from '../charts.js';
-import { ESTIMATORS, expandPlan, estimateLocal, fmtDuration, values } from '../plan.js';
-import { analyzeClient } from '../analysis.js';
+import { ESTIMATORS, expandPlan, fmtDuration, values } from '../plan.js';
 import { effMapOption, trajectoriesOption, cfgLabel } from './plots.js';
 import { escapeHtml } from './live.js';
 
@@ -41,7 +40,6 @@ export class SweepView {
     this.presets = [];
     this.base = {};
     this.current = null;       // {id, meta, plan, points, analysis, expanded}
-    this.pace = [];            // [wall ms, done] while running, for the ETA
     this.buildDims();
     this.mapCard = new ChartCard($('[data-chart="p-map"]'), { title: 'Efficiency map (ME angle)' });
     this.trajCard = new ChartCard($('[data-chart="p-traj"]'), { title: 'MTPA / ME trajectories' });
@@ -263,19 +261,9 @@ export class SweepView {
       text = `${r.points}${r.upper_bound || plan.mode === 'adaptive' ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time`;
       this.lastEstimate = r;
     } catch (e) {
-      if (e instanceof ApiError && (e.status === 404 || e.status === 405)) {
-        try {
-          const r = estimateLocal(plan);
-          text = `${r.points}${r.upper_bound ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time (estimated in the browser)`;
-          this.lastEstimate = r;
-        } catch (err) { text = `cannot estimate: ${err.message}`; bad = true; }
-      } else if (e.code === 'bad_plan' || e.status === 400) {
-        text = `Plan problems: ${e.message}`;
-        bad = true;
-      } else {
-        text = `cannot estimate: ${e.message}`;
-        bad = true;
-      }
+      bad = true;
+      text = e instanceof ApiError && (e.code === 'bad_plan' || e.status === 400)
+        ? `Plan problems: ${e.message}` : `cannot estimate: ${e.message}`;
     }
     if (seq !== this.estSeq) return;
     el.textContent = text;
@@ -299,7 +287,6 @@ export class SweepView {
     if (!this.current) return;
     try {
       await this.app.command('POST', `/api/sweeps/${this.current.id}/${a}`, {}, `Sweep ${this.current.id}: ${a}`);
-      this.pace = [];
       this.followRunning = true;
     } catch { /* toast shown */ }
     this.refreshCurrent(true);
@@ -309,7 +296,6 @@ export class SweepView {
   select(id, meta) {
     if (this.current?.id !== id) {
       this.current = { id, meta: meta || null, points: [], analysis: null, state: meta?.state };
-      this.pace = [];
       this.lastDone = -1;
     }
     this.refreshCurrent(true);
@@ -333,10 +319,6 @@ export class SweepView {
     c.total = s.total;
     if (s.eta_s !== undefined) c.eta_s = s.eta_s;
     if (s.error) c.error = s.error;
-    if (ACTIVE.includes(s.state)) {
-      this.pace.push([performance.now(), s.done]);
-      if (this.pace.length > 200) this.pace.shift();
-    }
     if (s.done !== this.lastDone) {
       this.lastDone = s.done;
       this.loadData();
@@ -380,12 +362,11 @@ export class SweepView {
       const points = await api('GET', `/api/sweeps/${c.id}/points`);
       c.points = points;
       this.lastLoadedDone = c.done;
-      let analysis = null;
-      try { analysis = await api('GET', `/api/sweeps/${c.id}/analysis`, undefined, { quiet401: true }); } catch (e) {
-        if (!(e.status === 404 || e.status === 405)) console.warn('analysis', e.message);
+      // The daemon's analysis (docs/analysis.md): one implementation, the one the reports use.
+      try { c.analysis = await api('GET', `/api/sweeps/${c.id}/analysis`, undefined, { quiet401: true }); } catch (e) {
+        c.analysis = null;
+        console.warn('analysis', e.message);
       }
-      // Fallback: the route is missing (404 "not_found" of the router, not of the sweep).
-      c.analysis = analysis || analyzeClient(points);
       this.renderProgress();
       this.renderCharts();
     } catch (e) {
@@ -396,14 +377,9 @@ export class SweepView {
     }
   }
 
+  // The daemon's figure (bench/pace.hpp: bench time per point so far); null until it has one.
   eta() {
-    const c = this.current;
-    if (c.eta_s != null) return c.eta_s;
-    if (!ACTIVE.includes(c.state) || this.pace.length < 2) return null;
-    const [t0, d0] = this.pace[0];
-    const [t1, d1] = this.pace[this.pace.length - 1];
-    if (d1 <= d0 || t1 <= t0) return null;
-    return ((c.total - d1) * (t1 - t0)) / (d1 - d0) / 1000;
+    return this.current.eta_s ?? null;
   }
 
   renderButtons() {
