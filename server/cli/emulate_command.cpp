@@ -54,6 +54,9 @@ register maps (at most one; default: the default profiles, drivers/profiles/):
   --bench CONFIG         the three profiles a bench config names, at its unit ids (its links are
                          not used: every device is served on each link given here, so their
                          registers must not collide)
+  A drive state a profile's "state" has no number for is served as its "otherwise", else as
+  its fallback (stopping as running, faulted as disabled) with a warning at start; one none of
+  these can show (running, disabled) is refused, exit 2 (docs/modbus.md)
 
 twin:
   --time-scale X         X seconds of twin time per wall second, 0 < X <= 1000 (default 1);
