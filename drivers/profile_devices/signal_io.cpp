@@ -110,8 +110,9 @@ std::string why_not(const RegisterEncoding& e, std::uint16_t mask, std::span<con
   open.min = -std::numeric_limits<double>::infinity();
   open.max = std::numeric_limits<double>::infinity();
   double v = 0;
-  const std::string encoding = " (" + std::string(name(e.type)) + (mask ? " mask " + std::to_string(mask) : "") +
-                               ", scale " + format_number(e.scale) + ", offset " + format_number(e.offset) + ")";
+  // The mask is already in the message's place (SignalIo::fail).
+  const std::string encoding = " (" + std::string(name(e.type)) + ", scale " + format_number(e.scale) + ", offset " +
+                               format_number(e.offset) + ")";
   if (decode_words(open, mask, words, v)) return "not a finite " + std::string(name(e.type)) + encoding;
   return format_number(v) + " is outside the profile's limits [" + format_number(e.min) + ", " +
          format_number(e.max) + "]" + encoding;

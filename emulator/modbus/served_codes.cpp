@@ -31,9 +31,10 @@ bool encodable(const ProfileSignal& s, double device_value) {
 
 // The number served for bench code `code`: its label's first number, or for the profile's
 // `otherwise` label the smallest number that reads as it (one the profile lists for no label).
-std::optional<double> own_number(DeviceKind kind, const ProfileSignal& s, std::size_t code) {
+std::optional<double> own_number(DeviceKind kind, const ProfileSignal& s, std::size_t code, std::string_view label) {
   double v = 0;
   if (!drivers::to_device_value(kind, s, static_cast<double>(code), v)) return v;
+  if (s.otherwise != label) return std::nullopt;
   const std::uint32_t top = drivers::is_bit_kind(s.kind) ? 1u : s.masked() ? drivers::field_max(s.mask) : 65535u;
   for (std::uint32_t n = 0; n <= top; ++n) {
     double back = 0;
@@ -59,7 +60,7 @@ ServedCodes served_codes(const drivers::DeviceProfile& p, const ProfileSignal& s
   const drivers::SignalSpec* spec = drivers::find_signal_spec(p.kind, s.name);
   if (!spec || spec->labels.empty() || drivers::is_fault_code(s)) return out;
   const auto& labels = spec->labels;
-  for (std::size_t c = 0; c < labels.size(); ++c) out.by_code.push_back(own_number(p.kind, s, c));
+  for (std::size_t c = 0; c < labels.size(); ++c) out.by_code.push_back(own_number(p.kind, s, c, labels[c]));
   if (!is_drive_state(p, s)) return out;
   const auto own = out.by_code;  // a fallback is to a state's own number, never to another fallback
   for (std::size_t c = 0; c < labels.size(); ++c) {

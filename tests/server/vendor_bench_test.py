@@ -285,6 +285,11 @@ def daemon_trip():
             trip_schema = {}
         check(trip_schema.get("fault_code_raw", {}).get("type") == "integer",
               f"serve: the OpenAPI schema of the status has supervisor.trip.fault_code_raw: {trip_schema}")
+        # The reset is refused (409 stop_in_progress) until the trip's ordered stop has ended.
+        def phase():
+            status, st = serve.request("GET", "/api/bench/status")
+            return (st.get("supervisor") or {}).get("phase") if status == 200 and isinstance(st, dict) else None
+        check(wait_for(lambda: phase() == "stopped", 30), f"serve: the trip's ordered stop ends (phase {phase()})")
         status, body = serve.request("POST", "/api/bench/reset")
         check(status == 200, f"serve: reset: {status} {str(body)[:200]}")
         status, st = serve.request("GET", "/api/bench/status")
