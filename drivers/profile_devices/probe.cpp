@@ -1,10 +1,10 @@
 // Probing a device: one single-signal ReadPlan per readable signal, through a bus wrapper that
 // keeps the words the device answered, so the raw registers and the decoded value come from one
-// read and one decoding (SignalIo's), and a value that does not decode is shown with its words.
+// read and one decoding (SignalIo's), and a value that does not decode is shown with its words
+// and SignalIo's own reason (the same message the bench would log).
 #include "drivers/profile_devices/probe.hpp"
 
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <string_view>
 
@@ -58,28 +58,6 @@ std::string number(double v) {
   return s.str();
 }
 
-// Why words that arrived do not decode, found by decoding them again step by step without the
-// limits: the reason SignalIo's errc::protocol does not spell out.
-std::string decode_problem(DeviceKind kind, const ProfileSignal& s, const std::vector<std::uint16_t>& raw,
-                           std::error_code ec) {
-  double v = 0;
-  if (is_bit_kind(s.kind)) {
-    if (raw.empty() || raw[0] > 1) return "the device answered a bit that is neither 0 nor 1";
-    v = raw[0];
-  } else {
-    RegisterEncoding open = s.encoding;
-    open.min = -std::numeric_limits<double>::infinity();
-    open.max = std::numeric_limits<double>::infinity();
-    if (decode_registers(open, raw, v)) return "the raw words are not a finite number";
-    if (v < s.encoding.min || v > s.encoding.max)
-      return number(v) + " is outside the profile's limits [" + number(s.encoding.min) + ", " +
-             number(s.encoding.max) + "]";
-  }
-  double code = 0;
-  if (to_bench_code(kind, s, v, code)) return "device code " + number(v) + " has no label in the profile's values";
-  return "does not decode: " + ec.message();
-}
-
 std::string label_of(DeviceKind kind, const ProfileSignal& s, double code) {
   if (!is_enumerated(kind, s)) return {};
   const SignalSpec* spec = find_signal_spec(kind, s.name);
@@ -111,9 +89,9 @@ std::vector<ProbeRow> probe_device(RegisterBus& bus, const DeviceProfile& profil
     const auto ec = io.read(plan, std::span(&value, 1));
     row.raw = recorder.last;
     if (ec) {
-      // Words that arrived and do not decode, or a request that failed on the link.
-      row.error = row.raw.empty() ? (bus.last_error().empty() ? ec.message() : bus.last_error())
-                                  : decode_problem(profile.kind, s, row.raw, ec);
+      // Words that arrived and do not decode, or a request that failed on the link: SignalIo
+      // names the place (device, signal, table, address, mask, unit id), the raw words and why.
+      row.error = io.last_error().empty() ? ec.message() : io.last_error();
     } else {
       row.value = value;
       row.label = label_of(profile.kind, s, value);

@@ -97,6 +97,27 @@ std::string limits_of(const RegisterEncoding& e) {
   return "limits " + format_number(e.min) + ".." + format_number(e.max);
 }
 
+// A masked signal is a field of its word; any other spans address_width(type) words.
+std::error_code decode_words(const RegisterEncoding& e, std::uint16_t mask, std::span<const std::uint16_t> words,
+                             double& value) {
+  return mask ? decode_field(e, mask, words[0], value) : decode_registers(e, words, value);
+}
+
+// Why words did not decode: decoded again without the limits (and through the same mask), so
+// the message has the value the device sent, not just "out of range".
+std::string why_not(const RegisterEncoding& e, std::uint16_t mask, std::span<const std::uint16_t> words) {
+  RegisterEncoding open = e;
+  open.min = -std::numeric_limits<double>::infinity();
+  open.max = std::numeric_limits<double>::infinity();
+  double v = 0;
+  // The mask is already in the message's place (SignalIo::fail).
+  const std::string encoding = " (" + std::string(name(e.type)) + ", scale " + format_number(e.scale) + ", offset " +
+                               format_number(e.offset) + ")";
+  if (decode_words(open, mask, words, v)) return "not a finite " + std::string(name(e.type)) + encoding;
+  return format_number(v) + " is outside the profile's limits [" + format_number(e.min) + ", " +
+         format_number(e.max) + "]" + encoding;
+}
+
 }  // namespace
 
 std::string SignalIo::device() const { return std::string(name(profile_.kind)) + " '" + profile_.name + "'"; }
@@ -120,11 +141,8 @@ std::error_code SignalIo::decode(const ProfileSignal& s, std::size_t at, double&
       e.min = -std::numeric_limits<double>::infinity();
       e.max = std::numeric_limits<double>::infinity();
     }
-    const auto ec = s.masked() ? decode_field(e, s.mask, words[0], device_value) : decode_registers(e, words, device_value);
-    if (ec)
-      return fail(ec, &s, "raw " + hex_words(words) + ": not a " + std::string(name(e.type)) + " within its " +
-                              limits_of(e) + " (scale " + format_number(e.scale) + ", offset " +
-                              format_number(e.offset) + ")");
+    const auto ec = decode_words(e, s.mask, words, device_value);
+    if (ec) return fail(ec, &s, "raw " + hex_words(words) + ": " + why_not(e, s.mask, words));
   }
   if (auto ec = to_bench_code(profile_.kind, s, device_value, bench_value)) {
     const std::size_t n = is_bit_kind(s.kind) ? 0 : address_width(s.encoding.type);

@@ -8,6 +8,7 @@
 #include "drivers/profile/register_codec.hpp"
 #include "drivers/profile/signal_codes.hpp"
 #include "emulator/modbus/modbus_pdu.hpp"
+#include "emulator/modbus/served_codes.hpp"
 
 namespace synbench::emulator {
 
@@ -29,7 +30,8 @@ std::size_t width(const drivers::ProfileSignal& s) { return drivers::address_wid
 RegisterServer::RegisterServer(std::vector<drivers::DeviceProfile> profiles, SignalProvider& provider)
     : profiles_(std::move(profiles)), provider_(provider) {
   for (const drivers::DeviceProfile& p : profiles_)
-    for (const drivers::ProfileSignal& s : p.signals) tables_[{s.unit_id, s.kind}].push_back(Entry{&s, p.kind, false, std::nullopt});
+    for (const drivers::ProfileSignal& s : p.signals)
+      tables_[{s.unit_id, s.kind}].push_back(Entry{&s, p.kind, false, std::nullopt, served_codes(p, s).by_code});
   for (auto& [key, t] : tables_)
     std::sort(t.begin(), t.end(), [](const Entry& a, const Entry& b) { return a.signal->address < b.signal->address; });
 }
@@ -74,9 +76,16 @@ std::array<std::uint16_t, 2> RegisterServer::raw(Entry& e) {
       s.role == drivers::SignalRole::window_start;
   double v = self_clearing ? 0.0 : provider_.read_signal(e.device, s);
   double device_value = 0;
-  // A fault the profile has no code for is served as the bench's own number, never as "none":
-  // the bench then reads it as unknown (or the profile's otherwise).
-  if (drivers::to_device_value(e.device, s, v, device_value)) device_value = drivers::is_fault_code(s) ? v : 0;
+  if (!e.served.empty()) {
+    // An enumerated signal: the code's own number, its `otherwise`, or a drive state's fallback
+    // (served_codes.hpp); 0 only for a code the map cannot show and the twin never takes.
+    const bool index = v >= 0 && v == std::floor(v) && v < static_cast<double>(e.served.size());
+    device_value = index ? e.served[static_cast<std::size_t>(v)].value_or(0.0) : 0.0;
+  } else if (drivers::to_device_value(e.device, s, v, device_value)) {
+    // A fault the profile has no code for is served as the bench's own number, never as "none":
+    // the bench then reads it as unknown (or the profile's otherwise).
+    device_value = drivers::is_fault_code(s) ? v : 0;
+  }
   if (drivers::is_bit_kind(s.kind)) {
     w[0] = device_value != 0 ? 1 : 0;
   } else if (s.masked()) {

@@ -42,6 +42,7 @@ class RegisterServer {
     drivers::DeviceKind device = drivers::DeviceKind::synrm_drive;
     bool stuck = false;
     std::optional<std::array<std::uint16_t, 2>> stuck_words;  // or the bit in [0]
+    std::vector<std::optional<double>> served;  // an enumerated signal's device number per code (served_codes.hpp)
   };
   using Table = std::vector<Entry>;  // sorted by address
   using TableKey = std::pair<std::uint8_t, drivers::RegisterKind>;

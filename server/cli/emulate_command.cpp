@@ -18,6 +18,7 @@
 #include "drivers/profile/profile_dir.hpp"
 #include "emulator/modbus/fault_injector.hpp"
 #include "emulator/modbus/rtu_server.hpp"
+#include "emulator/modbus/served_codes.hpp"
 #include "emulator/modbus/tcp_server.hpp"
 #include "emulator/modbus/twin_service.hpp"
 #include "emulator/twin_config_schema.hpp"
@@ -53,6 +54,9 @@ register maps (at most one; default: the default profiles, drivers/profiles/):
   --bench CONFIG         the three profiles a bench config names, at its unit ids (its links are
                          not used: every device is served on each link given here, so their
                          registers must not collide)
+  A drive state a profile's "state" has no number for is served as its "otherwise", else as
+  its fallback (stopping as running, faulted as disabled) with a warning at start; one none of
+  these can show (running, disabled) is refused, exit 2 (docs/modbus.md)
 
 twin:
   --time-scale X         X seconds of twin time per wall second, 0 < X <= 1000 (default 1);
@@ -163,6 +167,7 @@ int emulate_command(const std::vector<std::string>& argv) {
   std::optional<double> duration_s, watchdog_s;
   std::vector<std::pair<int, std::string>> stuck;
   std::vector<drivers::DeviceProfile> profiles;
+  std::string profiles_option = "--profiles";  // what to name when the profiles are refused
   try {
     Args a(argv, {"--help"},
            {"--tcp", "--rtu", "--baud", "--parity", "--time-scale", "--config", "--seed", "--udc-V", "--temp-C",
@@ -205,6 +210,7 @@ int emulate_command(const std::vector<std::string>& argv) {
     if (dir && bench) throw UsageError("--profiles", "give --profiles or --bench, not both");
     if (dir) profiles = dir_profiles(*dir);
     if (bench) profiles = bench_profiles(*bench);
+    if (bench) profiles_option = "--bench";
     if (auto seed = a.number("--seed")) {
       if (*seed < 0 || *seed > 2147483647 || *seed != std::floor(*seed))
         throw UsageError("--seed", "must be a whole number in [0, 2147483647]");
@@ -268,7 +274,15 @@ int emulate_command(const std::vector<std::string>& argv) {
     return 2;
   }
 
-  emulator::TwinService service(config, profiles.empty() ? default_profiles() : std::move(profiles));
+  if (profiles.empty()) profiles = default_profiles();
+  // Said once, at start: a drive state the map cannot show is served as its fallback, or refused.
+  const auto notes = emulator::check_served_codes(profiles);
+  for (const auto& w : notes.warnings) std::cerr << "synbench emulate: warning: " << w << "\n";
+  if (!notes.errors.empty()) {
+    for (const auto& e : notes.errors) std::cerr << "synbench emulate: " << profiles_option << ": " << e << "\n";
+    return 2;
+  }
+  emulator::TwinService service(config, std::move(profiles));
   for (const auto& [unit, signal] : stuck) {
     const auto ec = service.locked([&](auto&, auto&, emulator::RegisterServer& server) {
       return server.stick(static_cast<std::uint8_t>(unit), signal);

@@ -120,6 +120,56 @@ const char* phase_name(bench::SafetyPhase p) {
   return "?";
 }
 
+namespace {
+
+// A drive's own code of a fault its profile has no label for (fault "unknown"), else null.
+nlohmann::json raw_code(const std::optional<std::int64_t>& code) {
+  return code ? nlohmann::json(*code) : nlohmann::json(nullptr);
+}
+
+nlohmann::json object_schema(nlohmann::json properties, bool nullable = false) {
+  nlohmann::json o = {{"type", "object"}, {"properties", std::move(properties)}};
+  if (nullable) o["nullable"] = true;
+  return o;
+}
+
+// The status object of status_json() for the OpenAPI document (docs/api.md, "Status").
+nlohmann::json status_schema() {
+  const nlohmann::json num = {{"type", "number"}}, boolean = {{"type", "boolean"}}, str = {{"type", "string"}};
+  const nlohmann::json nullable_num = {{"type", "number"}, {"nullable", true}};
+  const nlohmann::json code_raw = {{"type", "integer"}, {"nullable", true},
+                                   {"description", "the device's own code of a fault its profile has no label for "
+                                                   "(fault unknown), else null"}};
+  return object_schema(
+      {{"t_s", num},
+       {"enabled", boolean},
+       {"stopping", boolean},
+       {"heartbeats", boolean},
+       {"setpoints", object_schema({{"speed_rpm", num}, {"load_Nm", num}, {"angle_deg", num}})},
+       {"mode", object_schema({{"estimator", str}, {"pwm", str}})},
+       {"synrm", object_schema({{"speed_rpm", num}, {"im_A", num}, {"id_A", num}, {"iq_A", num}, {"ud_V", num},
+                                {"uq_V", num}, {"udc_V", num}, {"pac_W", num}, {"temp_C", nullable_num},
+                                {"voltage_limited", boolean}, {"lock_lost", boolean}, {"pos_err_deg", nullable_num},
+                                {"state", str}, {"fault", str}, {"fault_code_raw", code_raw}},
+                               true)},
+       {"load", object_schema({{"torque_Nm", num}, {"iq_A", num}, {"state", str}, {"fault", str},
+                               {"fault_code_raw", code_raw}},
+                              true)},
+       {"supervisor",
+        object_schema({{"phase", str},
+                       {"tripped", boolean},
+                       {"trip", object_schema({{"fault", str}, {"fault_code_raw", code_raw}, {"detail", str}, {"at_s", num}})},
+                       {"alarm", object_schema({{"detail", str}, {"at_s", num}}, true)}})},
+       {"loop", object_schema({{"ticks", {{"type", "integer"}}}, {"overruns", {{"type", "integer"}}}})},
+       {"sweep", object_schema({{"id", {{"type", "integer"}}}, {"state", str}, {"done", {{"type", "integer"}}},
+                                {"total", {{"type", "integer"}}}, {"error", str}},
+                               true)},
+       {"events", {{"type", "array"},
+                   {"items", object_schema({{"t_s", num}, {"kind", str}, {"message", str}})}}}});
+}
+
+}  // namespace
+
 nlohmann::json status_json(const BenchStatus& s) {
   nlohmann::json j;
   j["t_s"] = s.t_s;
@@ -134,20 +184,24 @@ nlohmann::json status_json(const BenchStatus& s) {
                   {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
                   {"temp_C", t.temp_C ? nlohmann::json(*t.temp_C) : nlohmann::json(nullptr)},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
                   {"pos_err_deg", t.pos_err_deg ? nlohmann::json(*t.pos_err_deg) : nlohmann::json(nullptr)},
-                  {"state", drivers::state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))}};
+                  {"state", drivers::state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))},
+                  {"fault_code_raw", raw_code(t.fault_code_raw)}};
   } else {
     j["synrm"] = nullptr;
   }
   if (s.load) {
     const auto& t = *s.load;
     j["load"] = {{"torque_Nm", t.torque_Nm}, {"iq_A", t.iq_A}, {"state", drivers::state_name(t.state)},
-                 {"fault", std::string(drivers::fault_name(t.fault))}};
+                 {"fault", std::string(drivers::fault_name(t.fault))}, {"fault_code_raw", raw_code(t.fault_code_raw)}};
   } else {
     j["load"] = nullptr;
   }
   j["supervisor"] = {{"phase", phase_name(s.phase)}, {"tripped", s.trip.has_value()}};
   if (s.trip)
-    j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))}, {"detail", s.trip->detail}, {"at_s", s.trip->at_s}};
+    j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))},
+                               {"fault_code_raw", raw_code(s.trip->fault_code_raw)},
+                               {"detail", s.trip->detail},
+                               {"at_s", s.trip->at_s}};
   j["supervisor"]["alarm"] = s.alarm ? nlohmann::json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : nlohmann::json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
   if (s.sweep)
@@ -225,9 +279,11 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 r.body = prometheus_text(bench->snapshot()->status, metrics->by_status(), metrics->ws(), metrics->connections());
                 return r;
               }});
-  router.add({"GET", "/api/bench/status", Role::viewer,
-              "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
-              [bench](const Request&) { return status_response(*bench->snapshot()); }});
+  Route status{"GET", "/api/bench/status", Role::viewer,
+               "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
+               [bench](const Request&) { return status_response(*bench->snapshot()); }};
+  status.response_schema = status_schema();
+  router.add(std::move(status));
   router.add({"GET", "/api/bench/config", Role::viewer, "Limits the bench's setpoints are validated against.",
               [max_speed_rpm, max_load_Nm](const Request&) {
                 return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},

@@ -247,7 +247,9 @@ nlohmann::json Router::openapi(const std::string& title, const std::string& vers
     if (!params.empty()) op["parameters"] = params;
     if (r.request_schema)
       op["requestBody"] = {{"required", true}, {"content", {{"application/json", {{"schema", *r.request_schema}}}}}};
-    nlohmann::json responses = {{"200", {{"description", "success"}}},
+    nlohmann::json ok = {{"description", "success"}};
+    if (r.response_schema) ok["content"] = {{"application/json", {{"schema", *r.response_schema}}}};
+    nlohmann::json responses = {{"200", ok},
                                 {"default", {{"description", "error"},
                                              {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}}};
     if (r.role != Role::anyone) {

@@ -70,6 +70,7 @@ struct Route {
   Handler handler;             // one of the two
   AsyncHandler async_handler;
   std::optional<nlohmann::json> request_schema;  // JSON Schema of the body, if it takes one
+  std::optional<nlohmann::json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
 };
 
 // A token's role and a label naming its holder in messages and the control lock (the first

@@ -191,6 +191,34 @@ check(code == 2 and f"{collide_dir}/load_drive.json: signal 'enable' (coil 0 at 
 code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--bench", good, "--profiles", remap_dir)
 check(code == 2 and "not both" in err, "emulate --bench and --profiles together")
 
+
+def states_dir(name, values):
+    """The default profiles with the SynRM drive's state codes replaced by `values`."""
+    d = os.path.join(tmp, name)
+    os.makedirs(d)
+    for k in KINDS:
+        doc = load(k)
+        if k == "synrm_drive":
+            doc["signals"]["state"]["values"] = values
+        write(os.path.join(d, k + ".json"), doc)
+    return d
+
+
+# A drive state the map has no number for (docs/modbus.md, "Other register maps"): without
+# `stopping` the twin's ramp-down is served as running, said once at start; without `running`
+# (nor a fallback for stopping) the emulator refuses to start.
+no_stopping = states_dir("no_stopping", {"disabled": 0, "running": 1, "faulted": 3})
+code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--profiles", no_stopping, "--duration-s", "0.5")
+check(code == 0 and err.count("warning:") == 1 and
+      "warning: profile 'synbench SynRM drive' (synrm_drive): signal state has no number for 'stopping'; "
+      "the emulator serves 'running' (1) in that state" in err,
+      f"emulate warns once for a state served as its fallback: {code} {err.strip()[:300]}")
+no_running = states_dir("no_running", {"disabled": 0, "faulted": 3})
+code, out, err = run("emulate", "--tcp", "127.0.0.1:0", "--profiles", no_running)
+check(code == 2 and out == "" and "--profiles: profile 'synbench SynRM drive' (synrm_drive): signal state has no "
+      "number for 'running'" in err and "no number for 'stopping'" in err,
+      f"emulate refuses a drive state the map cannot show: {code} {err.strip()[:300]}")
+
 # The reference: the point on the default map, in-process, over 8 noise seeds.
 reference = []
 for seed in range(1, 9):

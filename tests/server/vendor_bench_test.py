@@ -7,10 +7,12 @@ fault codes without the watchdog's, word-swapped f32 and i32 telemetry, an any_w
 no window signals; a load drive with enable/reset coils, an i16 torque setpoint in 0.1 % of 10 N m
 and an any_write watchdog; a totalizer meter (u32 counters, 1 MHz time base).
 Checked: a whole point over TCP and over RTU (socat pty pair) against the same point on the
-default map; a 3-point sweep over TCP stored in SQLite; a watchdog trip mid-point (the master
+default map; a 3-point sweep over TCP and over RTU stored in SQLite; a watchdog trip mid-point (the master
 frozen with SIGSTOP) reported as fault `unknown` with the device code, the drives disabled and
 faulted on the far side, `bench reset` (a pulse) clearing it, twice, each time followed by a
-point that completes. Exit 77 (skipped) without socat."""
+point that completes; the same trip under `synbench serve --bench` (the daemon frozen), whose
+GET /api/bench/status trip and drives carry fault_code_raw 6, and its OpenAPI schema the field.
+Exit 77 (skipped) without socat."""
 import json
 import os
 import shutil
@@ -25,6 +27,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
 import far_side  # noqa: E402
+from daemon import Daemon, wait_for  # noqa: E402
 
 BIN = sys.argv[1]
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -132,43 +135,58 @@ tcp_rec = rec
 # A 3-point sweep. Thermal precondition left on (the plan's default): the vendor drive maps
 # temp_C, so the plan is allowed, and the twin's winding starts at 50 degC, inside the band, so no
 # warm-up runs; it proves a mapped temperature reaches the sweep engine.
-plan = os.path.join(tmp, "plan.json")
-with open(plan, "w") as f:
-    json.dump({"name": "vendor", "window_s": 1,
-               "dimensions": {"speed_rpm": [1000], "load_Nm": [2.0], "angle_deg": [52, 60, 68]}}, f)
-db = os.path.join(tmp, "vendor.db")
-t0 = time.time()
-code, out, err = run("sweep", plan, "--bench", tcp, "--db", db, "--quiet", timeout=300)
-check(code == 0, f"sweep --bench over TCP completes ({time.time() - t0:.1f} s): {err.strip()[-300:]}")
-sweep_eff = {}
-if os.path.exists(db):
+def plan_file(name, window_s):
+    path = os.path.join(tmp, name + ".json")
+    with open(path, "w") as f:
+        json.dump({"name": "vendor", "window_s": window_s,
+                   "dimensions": {"speed_rpm": [1000], "load_Nm": [2.0], "angle_deg": [52, 60, 68]}}, f)
+    return path
+
+
+# The same plan in-process on the default map: per angle, the vendor map within the point tolerance.
+db_ref = os.path.join(tmp, "reference.db")
+code, out, err = run("sweep", plan_file("plan_ref", 1), "--db", db_ref, "--quiet", timeout=300)
+reference_sweep = {}
+if code == 0:
+    con = sqlite3.connect(db_ref)
+    reference_sweep = dict(con.execute("select angle_deg, efficiency from points"))
+    con.close()
+check(len(reference_sweep) == 3, f"in-process reference sweep: {code} {err.strip()[-200:]}")
+
+
+def sweep(cfg, how, window_s):
+    """The 3-point plan over `cfg`, stored in SQLite: every point a host window without a fault,
+    each angle's efficiency within the point tolerance of the default map's."""
+    db = os.path.join(tmp, f"vendor_{how}.db")
+    t0 = time.time()
+    code, out, err = run("sweep", plan_file("plan_" + how, window_s), "--bench", cfg, "--db", db, "--quiet",
+                         timeout=300)
+    check(code == 0, f"{how}: sweep --bench completes ({time.time() - t0:.1f} s): {err.strip()[-300:]}")
+    if not os.path.exists(db):
+        return
     con = sqlite3.connect(db)
     state, total = con.execute("select state, total_points from sweeps order by id desc limit 1").fetchone()
     cols = [r[1] for r in con.execute("pragma table_info(points)")]
     rows = [dict(zip(cols, r)) for r in con.execute("select * from points order by point_index")]
     con.close()
     check(state == "completed" and total == 3 and len(rows) == 3,
-          f"sweep stored: state {state}, {len(rows)} of {total} points")
+          f"{how}: sweep stored: state {state}, {len(rows)} of {total} points")
     check(all(r.get("window_source") == "host" and (r.get("samples") or 0) > 10 and r.get("fault") is None
-              for r in rows), f"every swept point: host window, > 10 samples, no fault: "
+              for r in rows), f"{how}: every swept point: host window, > 10 samples, no fault: "
                               f"{[(r.get('angle_deg'), r.get('samples'), r.get('fault')) for r in rows]}")
-    sweep_eff = {r["angle_deg"]: r["efficiency"] for r in rows}
-# The same plan in-process on the default map: per angle, the vendor map within the point tolerance.
-db_ref = os.path.join(tmp, "reference.db")
-code, out, err = run("sweep", plan, "--db", db_ref, "--quiet", timeout=300)
-if code == 0 and sweep_eff:
-    con = sqlite3.connect(db_ref)
-    ref = dict(con.execute("select angle_deg, efficiency from points"))
-    con.close()
+    eff = {r["angle_deg"]: r["efficiency"] for r in rows}
+    if not reference_sweep or not eff:
+        return
     tol = max(6 * sigma, 5e-3 * base)
-    diffs = {a: sweep_eff[a] - ref.get(a, float("nan")) for a in sweep_eff}
+    diffs = {a: eff[a] - reference_sweep.get(a, float("nan")) for a in eff}
     check(all(abs(d) <= tol for d in diffs.values()),
-          "sweep: vendor vs default map per angle: " + ", ".join(
-              f"{a:g} deg {sweep_eff[a]:.5f}/{ref.get(a, float('nan')):.5f} ({d:+.2g})" for a, d in diffs.items()))
-    best_v, best_r = max(sweep_eff, key=sweep_eff.get), max(ref, key=ref.get)
-    print(f"info: best angle of the 3: vendor {best_v:g} deg, default map {best_r:g} deg")
-else:
-    check(False, f"in-process reference sweep: {code} {err.strip()[-200:]}")
+          f"{how}: sweep: vendor vs default map per angle: " + ", ".join(
+              f"{a:g} deg {eff[a]:.5f}/{reference_sweep.get(a, float('nan')):.5f} ({d:+.2g})" for a, d in diffs.items()))
+    best_v, best_r = max(eff, key=eff.get), max(reference_sweep, key=reference_sweep.get)
+    print(f"info: {how}: best angle of the 3: vendor {best_v:g} deg, default map {best_r:g} deg")
+
+
+sweep(tcp, "TCP", 1)
 
 
 def trip_and_reset(round_no):
@@ -225,6 +243,65 @@ trip_and_reset(1)
 # Twice: an edge-triggered drive resets only on a rising edge, so a reset written as a level
 # would leave the bit at 1 and the second reset would not clear.
 trip_and_reset(2)
+
+
+def daemon_trip():
+    """The same watchdog trip under `synbench serve --bench`, read from its REST status: the
+    trip's fault is unknown (or the load drive's, behind it) and carries the device's code."""
+    data_dir = os.path.join(tmp, "serve")
+    os.makedirs(data_dir)
+    serve = Daemon(BIN, data_dir, ["--bench", tcp], log_path=os.path.join(tmp, "serve.log"))
+    try:
+        status, body = serve.request("POST", "/api/bench/enable", {"enabled": True})
+        check(status == 200, f"serve: enable: {status} {str(body)[:200]}")
+        status, body = serve.request("POST", "/api/bench/setpoints", {"speed_rpm": 1000, "load_Nm": 2, "angle_deg": 60})
+        check(status == 200, f"serve: setpoints: {status} {str(body)[:200]}")
+        check(wait_for(lambda: far.input(UNIT["synrm_drive"], STATUS)[0] & 0xB == 3, 30),
+              "serve: far side, the SynRM drive runs")
+        serve.proc.send_signal(signal.SIGSTOP)
+        time.sleep(1.0)  # 20 s of twin time: past the drives' watchdog
+        tripped = all(far.input(u, STATUS, 2)[1] == WATCHDOG_CODE for u in UNIT.values())
+        serve.proc.send_signal(signal.SIGCONT)
+        check(tripped, "serve: far side, both drives report the device's code 6 while the daemon is frozen")
+
+        def trip():
+            status, st = serve.request("GET", "/api/bench/status")
+            return (st.get("supervisor") or {}).get("trip") if status == 200 and isinstance(st, dict) else None
+        check(wait_for(lambda: trip() is not None, 30), "serve: the supervisor trips after the freeze")
+        t = trip() or {}
+        check(t.get("fault") in ("unknown", "load_drive") and t.get("fault_code_raw") == WATCHDOG_CODE
+              and f"device code {WATCHDOG_CODE}" in t.get("detail", ""),
+              f"serve: GET /api/bench/status: the trip carries the device's code: {t}")
+        status, st = serve.request("GET", "/api/bench/status")
+        drives = {k: (st.get(k) or {}) for k in ("synrm", "load")} if isinstance(st, dict) else {}
+        check(all(d.get("fault") == "unknown" and d.get("fault_code_raw") == WATCHDOG_CODE for d in drives.values()),
+              f"serve: both drives' status: fault unknown, fault_code_raw 6: "
+              f"{ {k: (d.get('fault'), d.get('fault_code_raw')) for k, d in drives.items()} }")
+        status, doc = serve.request("GET", "/api/openapi.json")
+        try:
+            trip_schema = (doc["paths"]["/api/bench/status"]["get"]["responses"]["200"]["content"]["application/json"]
+                           ["schema"]["properties"]["supervisor"]["properties"]["trip"]["properties"])
+        except (KeyError, TypeError):
+            trip_schema = {}
+        check(trip_schema.get("fault_code_raw", {}).get("type") == "integer",
+              f"serve: the OpenAPI schema of the status has supervisor.trip.fault_code_raw: {trip_schema}")
+        # The reset is refused (409 stop_in_progress) until the trip's ordered stop has ended.
+        def phase():
+            status, st = serve.request("GET", "/api/bench/status")
+            return (st.get("supervisor") or {}).get("phase") if status == 200 and isinstance(st, dict) else None
+        check(wait_for(lambda: phase() == "stopped", 30), f"serve: the trip's ordered stop ends (phase {phase()})")
+        status, body = serve.request("POST", "/api/bench/reset")
+        check(status == 200, f"serve: reset: {status} {str(body)[:200]}")
+        status, st = serve.request("GET", "/api/bench/status")
+        check(status == 200 and (st.get("supervisor") or {}).get("trip") is None
+              and (st.get("synrm") or {}).get("fault_code_raw", 0) is None,
+              f"serve: after the reset no trip and no raw code: {str(st.get('supervisor'))[:200]}")
+    finally:
+        code, _ = serve.stop()
+        check(code == 0, f"serve: exits 0 on SIGTERM ({code})")
+
+
+daemon_trip()
 far.close()
 code, _ = emu.stop()
 check(code == 0, "emulate --bench over TCP stops on SIGTERM")
@@ -241,10 +318,13 @@ t0 = time.time()
 code, rec, err = point(rtu, "--window-s", "4")
 check(code == 0, f"point --bench on the vendor bench over RTU ({time.time() - t0:.1f} s): {err.strip()[:300]}")
 compare(rec, "RTU")
+rtu_rec = rec
+# The same 3-point sweep over the pty pair, with the point's 4 s window for the same reason.
+sweep(rtu, "RTU", 4)
 emu.stop()
 pair.stop()
 
-for how, r in (("TCP", tcp_rec), ("RTU", rec)):
+for how, r in (("TCP", tcp_rec), ("RTU", rtu_rec)):
     if r:
         print(f"info: {how}: efficiency {r['efficiency']:.6f} (default map {base:.6f} +- {sigma:.2g}), "
               f"{r['samples']} samples over {r['window_s']:.3f} s")

@@ -152,6 +152,12 @@ export class Link {
   }
 }
 
+// A fault's name, with the device's own code when its profile has no label for it
+// ("unknown (device code 6)", as the bench's events say it): status fault_code_raw.
+export function faultText(fault, codeRaw) {
+  return codeRaw == null ? fault : `${fault} (device code ${codeRaw})`;
+}
+
 export function statusToTelemetry(st) {
   const s = st.synrm || {};
   const fault = st.supervisor?.trip?.fault || (s.fault && s.fault !== 'none' ? s.fault : null)

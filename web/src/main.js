@@ -2,7 +2,7 @@
 // E-stop and the keyboard shortcuts. State shared by the views lives in `app`.
 import './style.css';
 import { api, setToken, setUnauthorizedHandler, ApiError } from './api.js';
-import { Link } from './link.js';
+import { Link, faultText } from './link.js';
 import { LiveView } from './views/live.js';
 import { SweepView } from './views/sweep.js';
 import { ResultsView } from './views/results.js';
@@ -104,7 +104,8 @@ function renderBenchPills(st) {
   document.body.dataset.bench = state;
   const trip = st.supervisor?.trip;
   const alarm = st.supervisor?.alarm;
-  const driveFault = [st.synrm?.fault, st.load?.fault].find((x) => x && x !== 'none');
+  const faulted = [st.synrm, st.load].find((d) => d?.fault && d.fault !== 'none');
+  const driveFault = faulted && faultText(faulted.fault, faulted.fault_code_raw);
   // A stop that did not take: as loud as the page can be, until a reset finds the drives stopped.
   const banner = $('#alarm-banner');
   banner.hidden = !alarm;
@@ -112,7 +113,7 @@ function renderBenchPills(st) {
     + `(heartbeats ${st.heartbeats === false ? 'stopped' : 'still sent'}): check the bench before anything else.` : '';
   document.body.classList.toggle('alarm', !!alarm);
   if (alarm) { f.dataset.state = 'tripped'; f.textContent = 'ALARM: drive not stopped'; f.title = alarm.detail; }
-  else if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${trip.fault}`; f.title = trip.detail || ''; }
+  else if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${faultText(trip.fault, trip.fault_code_raw)}`; f.title = trip.detail || ''; }
   else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
   else if (st.synrm?.lock_lost) {
     f.dataset.state = 'warn'; f.textContent = 'lock lost: on the encoder';

@@ -7,6 +7,7 @@
 
 #include "drivers/error.hpp"
 #include "drivers/profile_devices/probe.hpp"
+#include "tests/drivers/profile/vendor_profiles.hpp"
 #include "tests/drivers/profile_devices/fake_bus.hpp"
 
 namespace synbench::drivers {
@@ -119,6 +120,41 @@ TEST(Probe, ACodeWithoutALabelSaysSo) {
   EXPECT_NE(state.error.find("device code 0 has no label"), std::string::npos) << state.error;
   bus.at(row(rows, "state").unit_id, RegisterKind::input, row(rows, "state").address) = 5;
   EXPECT_EQ(row(probe_device(bus, p), "state").label, "disabled");
+}
+
+// A masked signal's error is decoded through its mask, as the bench decodes it: the status word's
+// other bits do not leak into the code or the value the message names.
+TEST(Probe, AMaskedSignalsErrorNamesItsFieldNotTheWholeWord) {
+  nlohmann::json doc = synbench::testing::vendor_words(synbench::testing::default_profile_doc(DeviceKind::synrm_drive),
+                                                       synbench::testing::pulse_reset());
+  doc["signals"]["state"].erase("otherwise");
+  doc["signals"]["state"]["values"].erase("stopping");
+  // The winding temperature in the status word's high byte, in degC, 0..100.
+  doc["signals"]["temp_C"] = {{"register", "input"}, {"address", 40}, {"type", "u16"}, {"mask", 0xFF00},
+                              {"unit", "C"}, {"min", 0}, {"max", 100}};
+  const DeviceProfile p = synbench::testing::parse_or_throw(doc);
+  FakeBus bus;
+  bus.at(p.unit_id, RegisterKind::input, 40) = 0xC8F6;  // state bits 0x000B: 2; temperature byte: 200
+  const auto rows = probe_device(bus, p);
+
+  const ProbeRow& state = row(rows, "state");
+  EXPECT_FALSE(state.value);
+  EXPECT_EQ(state.raw, std::vector<std::uint16_t>{0xC8F6});
+  EXPECT_NE(state.error.find("signal state (input 40 mask 11, unit id " + std::to_string(p.unit_id) + ")"),
+            std::string::npos) << state.error;
+  EXPECT_NE(state.error.find("raw 0xC8F6: device code 2 has no label"), std::string::npos) << state.error;
+
+  const ProbeRow& temp = row(rows, "temp_C");
+  EXPECT_FALSE(temp.value);
+  EXPECT_NE(temp.error.find("signal temp_C (input 40 mask 65280"), std::string::npos) << temp.error;
+  EXPECT_NE(temp.error.find("raw 0xC8F6: 200 is outside the profile's limits [0, 100]"), std::string::npos)
+      << temp.error;
+
+  // The same word with the fields in range decodes, whatever the other bits hold.
+  bus.at(p.unit_id, RegisterKind::input, 40) = 0x32F3;
+  const auto ok = probe_device(bus, p);
+  EXPECT_EQ(row(ok, "state").label, "running");
+  EXPECT_EQ(*row(ok, "temp_C").value, 50);
 }
 
 }  // namespace

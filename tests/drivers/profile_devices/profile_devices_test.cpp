@@ -318,8 +318,8 @@ TEST(ProfileSynrmDrive, DecodeErrorsNameDeviceSignalRegisterAndRawWords) {
   SynrmTelemetry t;
   EXPECT_EQ(drive.read(t), errc::protocol);
   EXPECT_EQ(drive.error_detail(),
-            "synrm_drive 'synbench SynRM drive': signal state (input 0, unit id 1): raw 0x0007: not a u16 within "
-            "its limits 0..3 (scale 1, offset 0)");
+            "synrm_drive 'synbench SynRM drive': signal state (input 0, unit id 1): raw 0x0007: 7 is outside the "
+            "profile's limits [0, 3] (u16, scale 1, offset 0)");
   bus.set(*drive.profile().find("state"), 1);
   bus.at(1, RegisterKind::input, 16) = 0x7FC0;  // f32 NaN
   bus.at(1, RegisterKind::input, 17) = 0x0000;

@@ -2,6 +2,7 @@
 // control (setpoints, enable / ordered stop, reset, estimator and PWM, control lock) and events.
 import { ChartCard, axis } from '../charts.js';
 import { api } from '../api.js';
+import { faultText } from '../link.js';
 import { ESTIMATORS } from '../plan.js';
 
 const WINDOW_S = 60;
@@ -174,7 +175,7 @@ export class LiveView {
       ['setpoints', `${fmt(st.setpoints?.speed_rpm, 0)} rpm, ${fmt(st.setpoints?.load_Nm, 2)} N m, ${fmt(st.setpoints?.angle_deg, 1)}°`],
     ];
     if (st.mode || st.estimator) rows.push(['estimator', `${st.mode?.estimator || st.estimator} / ${st.mode?.pwm || st.pwm || ''}`]);
-    if (st.supervisor?.trip) rows.push(['trip', `${st.supervisor.trip.fault}: ${st.supervisor.trip.detail}`]);
+    if (st.supervisor?.trip) rows.push(['trip', `${faultText(st.supervisor.trip.fault, st.supervisor.trip.fault_code_raw)}: ${st.supervisor.trip.detail}`]);
     if (st.supervisor?.alarm) rows.push(['ALARM', st.supervisor.alarm.detail]);
     if (st.heartbeats === false) rows.push(['heartbeats', "stopped until reset: the drives' watchdogs are armed"]);
     const html = rows.map(([k, val]) => `<dt>${k}</dt><dd data-k="${k}">${escapeHtml(String(val))}</dd>`).join('');
