@@ -8,6 +8,7 @@
 #include <string>
 
 #include "emulator/twin_bench.hpp"
+#include "tests/bench/fixed_angle_drive.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -36,6 +37,33 @@ TEST(PointProcedure, MeasuresSettlesAndEndsStopped) {
   EXPECT_LT(snap.speed_rpm, 25.0);
   EXPECT_NEAR(snap.load_torque_Nm, 0.0, 0.01);
   EXPECT_EQ(bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+}
+
+TEST(PointProcedure, RecordsTheCurrentAngleTheDriveRanAt) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  const auto p = run_point(bench.devices(), bench.clock(), request(700, 2.5, 62), PointOptions{});
+  ASSERT_TRUE(p.has_record()) << p.error();
+  const auto& r = p.record();
+  EXPECT_EQ(r.angle_deg, 62.0);
+  ASSERT_TRUE(r.angle_meas_deg);
+  EXPECT_NEAR(*r.angle_meas_deg, 62.0, 0.5) << "the current controller tracks the angle reference";
+  EXPECT_FALSE(r.angle_off);
+}
+
+TEST(PointProcedure, FlagsADriveThatDidNotRunAtTheRequestedAngle) {
+  // The drive holds 45 deg whatever it is sent: the point is measured (its powers are true for
+  // 45 deg) and stored with both angles and the warning.
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  testing::FixedAngleDrive deaf(*bench.devices().synrm, 45.0);
+  auto devices = bench.devices();
+  devices.synrm = &deaf;
+  const auto p = run_point(devices, bench.clock(), request(700, 2.5, 62), PointOptions{});
+  ASSERT_EQ(p.phase(), PointPhase::done) << p.error();
+  const auto& r = p.record();
+  EXPECT_EQ(r.angle_deg, 62.0);
+  EXPECT_NEAR(r.angle_meas_deg.value_or(0.0), 45.0, 0.5);
+  EXPECT_TRUE(r.angle_off);
+  EXPECT_FALSE(r.voltage_limited);
 }
 
 TEST(PointProcedure, AnUnsettledPointIsMeasuredAndFlaggedNotDropped) {
@@ -224,7 +252,8 @@ StartAngles start_angles(drivers::Estimator e, double angle_deg) {
   EXPECT_EQ(p.phase(), PointPhase::done) << p.error();
   EXPECT_TRUE(p.has_record());
   const auto& r = p.record();
-  out.measured_deg = std::atan2(r.iq_A, r.id_A) * 180.0 / 3.14159265358979323846;
+  out.measured_deg = r.angle_meas_deg.value_or(-1.0);
+  EXPECT_FALSE(r.angle_off) << "measured " << out.measured_deg << " deg for " << angle_deg;
   out.lock_lost = r.lock_lost;
   return out;
 }
