@@ -281,28 +281,45 @@ TEST(PointProcedure, ASensorlessPointTakesItsLoadAtTheStartAngleAndIsMeasuredAtI
 // Spun up unloaded at its own angle, EEMF-CONST slips during the speed overshoot (its EEMF is a
 // few volts there) and the point is lost before its load arrives: at 700 rpm, 58 deg and at
 // 500 rpm, 40 deg (where only the early load helps, the angle being below the start angle).
-// The sensorless start holds both.
+// The sensorless start holds both, at each of five noise seeds. The plain start's slip is the
+// motivation, and over seeds it is a chance: at 500 rpm, 40 deg it slipped at all five, at
+// 700 rpm, 58 deg at seeds 1 and 4 only (2026-12-03), so it is asserted as "at some seed".
 TEST(PointProcedure, TheSensorlessStartKeepsEemfConstInLock) {
   struct Case {
     double speed_rpm, load_Nm, angle_deg;
   };
   for (const Case c : {Case{700, 2.0, 58}, Case{500, 1.5, 40}})
     for (const bool plain : {true, false}) {
-      emulator::TwinBench bench{emulator::TwinConfig{}};
-      PointRequest req = request(c.speed_rpm, c.load_Nm, c.angle_deg);
-      req.estimator = drivers::Estimator::eemf_const;
-      PointOptions opt;
-      opt.settle_timeout_s = 5.0;
-      if (plain) {
-        opt.sensorless_start_angle_deg = 0;
-        opt.sensorless_load_at_speed_fraction = 1.0;
+      int lost = 0;
+      std::string lost_at;
+      for (const int seed : {1, 2, 3, 4, 5}) {
+        emulator::TwinConfig cfg;
+        cfg.sim.seed_int = seed;
+        emulator::TwinBench bench{cfg};
+        PointRequest req = request(c.speed_rpm, c.load_Nm, c.angle_deg);
+        req.estimator = drivers::Estimator::eemf_const;
+        PointOptions opt;
+        opt.settle_timeout_s = 5.0;
+        if (plain) {
+          opt.sensorless_start_angle_deg = 0;
+          opt.sensorless_load_at_speed_fraction = 1.0;
+        }
+        const auto p = run_point(bench.devices(), bench.clock(), req, opt);
+        const std::string at = std::to_string(c.speed_rpm) + " rpm " + std::to_string(c.angle_deg) + " deg, " +
+                               (plain ? "plain start" : "sensorless start") + ", seed " + std::to_string(seed);
+        ASSERT_TRUE(p.has_record()) << at << ": " << p.error();
+        EXPECT_FALSE(p.record().fault) << at;
+        if (p.record().lock_lost) {
+          ++lost;
+          lost_at += " " + std::to_string(seed);
+        }
       }
-      const auto p = run_point(bench.devices(), bench.clock(), req, opt);
-      const std::string at = std::to_string(c.speed_rpm) + " rpm " + std::to_string(c.angle_deg) +
-                             " deg, " + (plain ? "plain start" : "sensorless start");
-      ASSERT_TRUE(p.has_record()) << at << ": " << p.error();
-      EXPECT_EQ(p.record().lock_lost, plain) << at;
-      EXPECT_FALSE(p.record().fault) << at;
+      std::printf("EEMF-CONST %.0f rpm %.0f deg, %s: lock lost at %d of 5 seeds (%s)\n", c.speed_rpm, c.angle_deg,
+                  plain ? "plain start" : "sensorless start", lost, lost_at.c_str());
+      if (plain)
+        EXPECT_GE(lost, 1) << c.speed_rpm << " rpm: the plain start never slipped, the sensorless start is moot";
+      else
+        EXPECT_EQ(lost, 0) << c.speed_rpm << " rpm: the sensorless start lost the rotor at seeds" << lost_at;
     }
 }
 
