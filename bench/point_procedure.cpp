@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "bench/current_angle.hpp"
 #include "bench/window_plausibility.hpp"
 #include "drivers/error.hpp"
 
@@ -334,6 +335,9 @@ std::error_code PointProcedure::read_results(const char*& what) {
   r.im_A = w.im_A;
   r.id_A = w.id_A;
   r.iq_A = w.iq_A;
+  // The angle the drive ran at, from the same means (a host window's are of the polled telemetry).
+  r.angle_meas_deg = current_angle_deg(w.id_A, w.iq_A);
+  r.angle_off = angle_off(req_.angle_deg, w.id_A, w.iq_A);
   r.ud_V = w.ud_V;
   r.uq_V = w.uq_V;
   r.udc_V = w.udc_V;

@@ -57,6 +57,8 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["lock_lost"] = r.lock_lost;
   j["window_source"] = drivers::keeper_name(r.window_source);
   j["fault_code_raw"] = r.fault_code_raw ? nlohmann::ordered_json(*r.fault_code_raw) : nlohmann::ordered_json(nullptr);
+  j["angle_meas_deg"] = opt(r.angle_meas_deg);
+  j["angle_off"] = r.angle_off;
   if (r.truth) {
     const auto& t = *r.truth;
     j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},

@@ -43,6 +43,12 @@ struct PointRecord {
   bool lock_lost = false;
   // The device's own code of a fault its profile has no label for (fault "unknown").
   std::optional<std::int64_t> fault_code_raw;
+  // The current angle th_i of the window's mean (id_A, iq_A), next to the requested angle_deg
+  // (bench/current_angle.hpp); empty for a zero mean current and on rows stored before it.
+  std::optional<double> angle_meas_deg;
+  // angle_meas_deg is further from angle_deg than the measurement allows at this current: the
+  // drive did not run at the requested angle (a warning; false below the current it is judged at).
+  bool angle_off = false;
   // emulator only: the plant's own values over the window
   std::optional<drivers::TruthWindow> truth;
 };

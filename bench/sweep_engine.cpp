@@ -139,6 +139,17 @@ void SweepEngine::finish_point(double /*now_s*/) {
                            ": the estimator lost the rotor; the drive's lock guard ran the point "
                            "on the encoder");
   }
+  if (r.angle_off) {
+    // Stored (its powers are true for the angle it ran at), but a lab must not take it for the
+    // requested angle: say so where the sweep's events are read.
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "point %zu: the drive ran at a current angle of %.1f deg, not the requested %.1f deg "
+                  "(angle_off)%s",
+                  static_cast<std::size_t>(n.point.index), r.angle_meas_deg.value_or(0.0), r.angle_deg,
+                  r.voltage_limited ? "; the window was voltage limited" : "");
+    sink_.event("log", what);
+  }
   if (proc->speed_lost()) {
     // The drive lost the speed (a sensorless observer that slipped off the rotor does not find
     // it again while the shaft stalls): ordered stop, and the next point starts from standstill.

@@ -125,6 +125,14 @@ constexpr std::string_view kSchemaV6 = R"sql(
 ALTER TABLE points ADD COLUMN fault_code_raw INTEGER;
 )sql";
 
+// Version 7: the measured current angle of the window's mean (i_d, i_q) next to the requested
+// one, and the flag that they disagree beyond the measurement's tolerance. Rows from before have
+// no measured angle (NULL) and were never judged (0).
+constexpr std::string_view kSchemaV7 = R"sql(
+ALTER TABLE points ADD COLUMN angle_meas_deg ANY CHECK (typeof(angle_meas_deg) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN angle_off INTEGER NOT NULL DEFAULT 0 CHECK (angle_off IN (0, 1));
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
@@ -132,6 +140,7 @@ constexpr std::array kMigrations{
     Migration{4, "sweeps: owner_host, owner_pid, owner_start", kSchemaV4},
     Migration{5, "points: window_source", kSchemaV5},
     Migration{6, "points: fault_code_raw", kSchemaV6},
+    Migration{7, "points: angle_meas_deg, angle_off", kSchemaV7},
 };
 
 struct Header {

@@ -28,7 +28,7 @@ struct RecordColumn {
   Member member;
 };
 
-inline const std::array<RecordColumn, 40> kRecordColumns{{
+inline const std::array<RecordColumn, 42> kRecordColumns{{
     {"speed_rpm", &PointRecord::speed_rpm},
     {"load_Nm", &PointRecord::load_Nm},
     {"angle_deg", &PointRecord::angle_deg},
@@ -69,6 +69,8 @@ inline const std::array<RecordColumn, 40> kRecordColumns{{
     {"lock_lost", &PointRecord::lock_lost},                // schema version 3
     {"window_source", &PointRecord::window_source},        // schema version 5
     {"fault_code_raw", &PointRecord::fault_code_raw},      // schema version 6
+    {"angle_meas_deg", &PointRecord::angle_meas_deg},      // schema version 7
+    {"angle_off", &PointRecord::angle_off},
 }};
 
 }  // namespace synbench::db::detail

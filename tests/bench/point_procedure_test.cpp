@@ -8,6 +8,7 @@
 #include <string>
 
 #include "emulator/twin_bench.hpp"
+#include "tests/bench/fixed_angle_drive.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -36,6 +37,33 @@ TEST(PointProcedure, MeasuresSettlesAndEndsStopped) {
   EXPECT_LT(snap.speed_rpm, 25.0);
   EXPECT_NEAR(snap.load_torque_Nm, 0.0, 0.01);
   EXPECT_EQ(bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+}
+
+TEST(PointProcedure, RecordsTheCurrentAngleTheDriveRanAt) {
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  const auto p = run_point(bench.devices(), bench.clock(), request(700, 2.5, 62), PointOptions{});
+  ASSERT_TRUE(p.has_record()) << p.error();
+  const auto& r = p.record();
+  EXPECT_EQ(r.angle_deg, 62.0);
+  ASSERT_TRUE(r.angle_meas_deg);
+  EXPECT_NEAR(*r.angle_meas_deg, 62.0, 0.5) << "the current controller tracks the angle reference";
+  EXPECT_FALSE(r.angle_off);
+}
+
+TEST(PointProcedure, FlagsADriveThatDidNotRunAtTheRequestedAngle) {
+  // The drive holds 45 deg whatever it is sent: the point is measured (its powers are true for
+  // 45 deg) and stored with both angles and the warning.
+  emulator::TwinBench bench{emulator::TwinConfig{}};
+  testing::FixedAngleDrive deaf(*bench.devices().synrm, 45.0);
+  auto devices = bench.devices();
+  devices.synrm = &deaf;
+  const auto p = run_point(devices, bench.clock(), request(700, 2.5, 62), PointOptions{});
+  ASSERT_EQ(p.phase(), PointPhase::done) << p.error();
+  const auto& r = p.record();
+  EXPECT_EQ(r.angle_deg, 62.0);
+  EXPECT_NEAR(r.angle_meas_deg.value_or(0.0), 45.0, 0.5);
+  EXPECT_TRUE(r.angle_off);
+  EXPECT_FALSE(r.voltage_limited);
 }
 
 TEST(PointProcedure, AnUnsettledPointIsMeasuredAndFlaggedNotDropped) {
@@ -224,7 +252,8 @@ StartAngles start_angles(drivers::Estimator e, double angle_deg) {
   EXPECT_EQ(p.phase(), PointPhase::done) << p.error();
   EXPECT_TRUE(p.has_record());
   const auto& r = p.record();
-  out.measured_deg = std::atan2(r.iq_A, r.id_A) * 180.0 / 3.14159265358979323846;
+  out.measured_deg = r.angle_meas_deg.value_or(-1.0);
+  EXPECT_FALSE(r.angle_off) << "measured " << out.measured_deg << " deg for " << angle_deg;
   out.lock_lost = r.lock_lost;
   return out;
 }
@@ -252,28 +281,45 @@ TEST(PointProcedure, ASensorlessPointTakesItsLoadAtTheStartAngleAndIsMeasuredAtI
 // Spun up unloaded at its own angle, EEMF-CONST slips during the speed overshoot (its EEMF is a
 // few volts there) and the point is lost before its load arrives: at 700 rpm, 58 deg and at
 // 500 rpm, 40 deg (where only the early load helps, the angle being below the start angle).
-// The sensorless start holds both.
+// The sensorless start holds both, at each of five noise seeds. The plain start's slip is the
+// motivation, and over seeds it is a chance: at 500 rpm, 40 deg it slipped at all five, at
+// 700 rpm, 58 deg at seeds 1 and 4 only (2026-12-03), so it is asserted as "at some seed".
 TEST(PointProcedure, TheSensorlessStartKeepsEemfConstInLock) {
   struct Case {
     double speed_rpm, load_Nm, angle_deg;
   };
   for (const Case c : {Case{700, 2.0, 58}, Case{500, 1.5, 40}})
     for (const bool plain : {true, false}) {
-      emulator::TwinBench bench{emulator::TwinConfig{}};
-      PointRequest req = request(c.speed_rpm, c.load_Nm, c.angle_deg);
-      req.estimator = drivers::Estimator::eemf_const;
-      PointOptions opt;
-      opt.settle_timeout_s = 5.0;
-      if (plain) {
-        opt.sensorless_start_angle_deg = 0;
-        opt.sensorless_load_at_speed_fraction = 1.0;
+      int lost = 0;
+      std::string lost_at;
+      for (const int seed : {1, 2, 3, 4, 5}) {
+        emulator::TwinConfig cfg;
+        cfg.sim.seed_int = seed;
+        emulator::TwinBench bench{cfg};
+        PointRequest req = request(c.speed_rpm, c.load_Nm, c.angle_deg);
+        req.estimator = drivers::Estimator::eemf_const;
+        PointOptions opt;
+        opt.settle_timeout_s = 5.0;
+        if (plain) {
+          opt.sensorless_start_angle_deg = 0;
+          opt.sensorless_load_at_speed_fraction = 1.0;
+        }
+        const auto p = run_point(bench.devices(), bench.clock(), req, opt);
+        const std::string at = std::to_string(c.speed_rpm) + " rpm " + std::to_string(c.angle_deg) + " deg, " +
+                               (plain ? "plain start" : "sensorless start") + ", seed " + std::to_string(seed);
+        ASSERT_TRUE(p.has_record()) << at << ": " << p.error();
+        EXPECT_FALSE(p.record().fault) << at;
+        if (p.record().lock_lost) {
+          ++lost;
+          lost_at += " " + std::to_string(seed);
+        }
       }
-      const auto p = run_point(bench.devices(), bench.clock(), req, opt);
-      const std::string at = std::to_string(c.speed_rpm) + " rpm " + std::to_string(c.angle_deg) +
-                             " deg, " + (plain ? "plain start" : "sensorless start");
-      ASSERT_TRUE(p.has_record()) << at << ": " << p.error();
-      EXPECT_EQ(p.record().lock_lost, plain) << at;
-      EXPECT_FALSE(p.record().fault) << at;
+      std::printf("EEMF-CONST %.0f rpm %.0f deg, %s: lock lost at %d of 5 seeds (%s)\n", c.speed_rpm, c.angle_deg,
+                  plain ? "plain start" : "sensorless start", lost, lost_at.c_str());
+      if (plain)
+        EXPECT_GE(lost, 1) << c.speed_rpm << " rpm: the plain start never slipped, the sensorless start is moot";
+      else
+        EXPECT_EQ(lost, 0) << c.speed_rpm << " rpm: the sensorless start lost the rotor at seeds" << lost_at;
     }
 }
 

@@ -14,6 +14,7 @@
 
 #include "drivers/error.hpp"
 #include "emulator/twin_bench.hpp"
+#include "tests/bench/fixed_angle_drive.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -83,12 +84,39 @@ TEST(SweepEngine, CompletesAGridInOrderAndEndsStopped) {
     EXPECT_NEAR(r.speed_meas_rpm, r.speed_rpm, 1.0) << i;
     EXPECT_GT(r.pdcm_W, r.pm_W) << i;
     EXPECT_FALSE(r.unstable) << i;
+    // The drive ran at the requested angle, not only the record says so.
+    ASSERT_TRUE(r.angle_meas_deg) << i;
+    EXPECT_NEAR(*r.angle_meas_deg, r.angle_deg, 0.5) << i;
+    EXPECT_FALSE(r.angle_off) << i;
   }
+  EXPECT_TRUE(std::none_of(sink.events.begin(), sink.events.end(),
+                           [](const std::string& ev) { return ev.find("angle_off") != std::string::npos; }));
   EXPECT_EQ(run.bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
   run.bench.clock().wait_until(run.t + 5.0);  // disabled below 20 rpm, the shaft coasts out
   EXPECT_LT(std::fabs(run.bench.twin().snapshot().speed_rpm), 5.0);
   // Chained points are quicker than from standstill.
   EXPECT_LT(sink.points[1].second.settle_s, sink.points[0].second.settle_s);
+}
+
+TEST(SweepEngine, StoresAndLogsAPointTheDriveRanAtAnotherAngle) {
+  TwinRun run;
+  testing::FixedAngleDrive deaf(*run.bench.devices().synrm, 45.0);
+  auto devices = run.bench.devices();
+  devices.synrm = &deaf;
+  VectorSink sink;
+  SweepEngine e(devices, run.sup, plan_from(R"({
+    "dimensions": {"speed_rpm": [700], "load_Nm": [2.0], "angle_deg": [45, 62]},
+    "window_s": 0.5, "thermal": {"enabled": false}})"), {}, sink);
+  run.until(e, 120);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 2u);
+  EXPECT_FALSE(sink.points[0].second.angle_off) << "45 deg was what it ran at";
+  EXPECT_TRUE(sink.points[1].second.angle_off);
+  const auto logged = std::count_if(sink.events.begin(), sink.events.end(), [](const std::string& ev) {
+    return ev.find("point 1: the drive ran at a current angle of 45.0 deg, not the requested 62.0 deg") !=
+           std::string::npos;
+  });
+  EXPECT_EQ(logged, 1);
 }
 
 TEST(SweepEngine, ResumesAtTheMissingPointsOnly) {

@@ -160,10 +160,14 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
     r.fallback_fraction = 0.9;
     r.lock_lost = true;
     r.window_source = drivers::WindowKeeper::host;
+    r.angle_meas_deg = 61.5;
+    r.angle_off = true;
     ASSERT_TRUE(store->insert_point(id, 0, r));
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN angle_off");
+    raw.exec("ALTER TABLE points DROP COLUMN angle_meas_deg");
     raw.exec("ALTER TABLE points DROP COLUMN window_source");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
@@ -183,6 +187,8 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   EXPECT_EQ(rows[0].record.fallback_fraction, 0.0);
   EXPECT_FALSE(rows[0].record.lock_lost);
   EXPECT_EQ(rows[0].record.window_source, drivers::WindowKeeper::device);
+  EXPECT_FALSE(rows[0].record.angle_meas_deg) << "not measured before version 7";
+  EXPECT_FALSE(rows[0].record.angle_off);
   EXPECT_EQ(rows[0].record.im_A, testing::sample_record(3).im_A);
 }
 
@@ -203,6 +209,8 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN angle_off");
+    raw.exec("ALTER TABLE points DROP COLUMN angle_meas_deg");
     raw.exec("ALTER TABLE points DROP COLUMN window_source");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_start");
     raw.exec("ALTER TABLE sweeps DROP COLUMN owner_pid");
@@ -270,7 +278,8 @@ TEST(Schema, PointColumnsAreTheRecordFieldsInOrder) {
   const auto path = dir / "schema.db";
   { ASSERT_TRUE(Store::open(path)); }
   // Version 1's columns, then those later migrations added (ALTER TABLE appends them).
-  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "window_source", "fault_code_raw"};
+  const std::vector<std::string> added{"below_min_speed", "fallback_fraction", "lock_lost", "window_source", "fault_code_raw",
+                                         "angle_meas_deg", "angle_off"};
   const auto n_added = static_cast<std::ptrdiff_t>(added.size());
   ASSERT_EQ(std::vector<std::string>(record_fields.end() - n_added, record_fields.end()), added);
   std::vector<std::string> expected{"id", "sweep_id", "point_index"};

@@ -29,6 +29,8 @@ inline bench::PointRecord sample_record(std::int64_t i) {
   r.im_A = std::sqrt(2.0) * (1 + x);
   r.id_A = std::cos(x);
   r.iq_A = std::sin(x);
+  if (i % 13 != 12) r.angle_meas_deg = i % 2 == 0 ? 45.0 + 1e-7 * x : 90.0 - 1.0 / (3.0 + x);  // null on some
+  r.angle_off = i % 8 == 6;
   r.ud_V = -std::numeric_limits<double>::denorm_min() * static_cast<double>(i % 3);  // subnormal
   r.uq_V = 1e-300 * x;
   r.udc_V = 565.0 + std::nextafter(0.0, 1.0) * x;

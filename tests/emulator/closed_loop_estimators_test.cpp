@@ -305,6 +305,8 @@ TEST(ClosedLoopEstimators, EemfRlsSpreadsWithTheAngleAndThePrbsCostsCurrentAndPo
     EXPECT_LT(spread, 90.0) << at << ": out of lock";
     EXPECT_GT(spread, 10.0) << at;
     EXPECT_GT(spread, 10.0 * (*lut.pos_err_max_deg - *lut.pos_err_min_deg)) << at;
+    // At the default seed only: per point this bound is a noise draw's (-8.8 % at 40 deg with
+    // seed 2); estimators_over_seeds_test.cpp tests the thesis's "tens of percent" over seeds.
     EXPECT_GT(std::fabs(*rls.rs_err_pct), 10.0) << at;
     EXPECT_LT(std::fabs(*rls.rs_err_pct), 80.0) << at;
   }

@@ -13,7 +13,8 @@ BIN = sys.argv[1]
 RECORD_FIELDS = """speed_rpm load_Nm angle_deg estimator pwm speed_meas_rpm im_A id_A iq_A ud_V uq_V
 udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W efficiency pos_err_min_deg pos_err_mean_deg pos_err_max_deg
 speed_err_rpm ld_est_H lq_est_H rs_est_ohm ld_err_pct lq_err_pct rs_err_pct temp_C window_s samples
-settle_s voltage_limited unstable fault below_min_speed fallback_fraction lock_lost window_source fault_code_raw truth""".split()
+settle_s voltage_limited unstable fault below_min_speed fallback_fraction lock_lost window_source fault_code_raw
+angle_meas_deg angle_off truth""".split()
 TRUTH_FIELDS = "pin_W pcu_W pfe_W pmech_W pinvm_W pm_W temp_C".split()
 check = Checks(verbose=True)
 
@@ -36,6 +37,7 @@ rec = json.loads(out)
 check(list(rec.keys()) == RECORD_FIELDS, "record has the experiment.md fields in order")
 check(sorted(rec["truth"].keys()) == sorted(TRUTH_FIELDS), "truth object fields")
 check(abs(rec["speed_meas_rpm"] - 700) < 0.5, "measured speed at the setpoint")
+check(abs(rec["angle_meas_deg"] - 52) < 0.5 and rec["angle_off"] is False, "the drive ran at the requested current angle")
 check(rec["samples"] == 10000 and rec["window_s"] == 1 and rec["window_source"] == "device", "one-second window at 10 kHz, kept by the drive")
 check(50 < rec["pdcm_W"] < 1000 and 0.3 < rec["efficiency"] < 0.95, "plausible power and efficiency")
 check(rec["estimator"] == "encoder" and rec["pwm"] == "capwm" and rec["fault"] is None, "setpoints and flags")

@@ -116,6 +116,10 @@ def compare(rec, how):
         check(abs(d) <= tol, f"{how}: vendor efficiency {rec['efficiency']:.6f} vs default map {base:.6f} "
                              f"(d {d:+.2g}, {100 * d / base:+.3f} %, tolerance {tol:.2g}, sigma {sigma:.2g})")
         check(rec["temp_C"] is not None and abs(rec["temp_C"] - 50) < 5, f"{how}: temp_C mapped: {rec['temp_C']}")
+        # The host window's angle is that of the polled telemetry's mean id, iq: the drive ran
+        # at the request as read back through the vendor map.
+        check(rec.get("angle_off") is False and abs((rec.get("angle_meas_deg") or 0) - rec["angle_deg"]) < 2,
+              f"{how}: measured current angle {rec.get('angle_meas_deg')} deg for {rec['angle_deg']} deg")
 
 
 # --- over TCP: a point, a sweep, a watchdog trip with an unknown fault code --------------------
@@ -174,6 +178,8 @@ def sweep(cfg, how, window_s):
     check(all(r.get("window_source") == "host" and (r.get("samples") or 0) > 10 and r.get("fault") is None
               for r in rows), f"{how}: every swept point: host window, > 10 samples, no fault: "
                               f"{[(r.get('angle_deg'), r.get('samples'), r.get('fault')) for r in rows]}")
+    check(all(r.get("angle_off") == 0 and abs((r.get("angle_meas_deg") or 0) - r["angle_deg"]) < 2 for r in rows),
+          f"{how}: every swept point ran at its angle: {[(r.get('angle_deg'), r.get('angle_meas_deg')) for r in rows]}")
     eff = {r["angle_deg"]: r["efficiency"] for r in rows}
     if not reference_sweep or not eff:
         return
