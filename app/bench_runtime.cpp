@@ -1,6 +1,7 @@
 // The bench thread and its command queue; see bench_runtime.hpp.
 #include "app/bench_runtime.hpp"
 
+#include <algorithm>
 
 #include "app/plan_needs.hpp"
 #include "bench/load_ramp.hpp"
@@ -85,13 +86,24 @@ void BenchRuntime::run() {
     if (target_s > backend_->clock().now_s()) backend_->clock().wait_until(target_s);
     const double now_s = backend_->clock().now_s();
     auto answers = act_on_commands(now_s);
+    // An E-stop is answered once both disables were tried, not after the tick's reads: on a
+    // starved line those may take seconds, and its snapshot already says per drive whether the
+    // disable was acknowledged or is being repeated (status.disable, until the read-back).
+    const auto estops_end = std::stable_partition(answers.begin(), answers.end(), [](const Answer& a) { return a.estop; });
+    if (estops_end != answers.begin()) {
+      publish();
+      const auto snap = snapshot();
+      for (auto it = answers.begin(); it != estops_end; ++it)
+        if (it->done) it->done({std::move(it->refusal), snap});
+      answers.erase(answers.begin(), estops_end);
+    }
     const bool due = clock::now() >= next;
     // A command is answered after a tick that read the drives back, not before.
     if (due || !answers.empty()) tick(now_s);
     publish();
     const auto snap = snapshot();
-    for (auto& [done, refusal] : answers)
-      if (done) done({std::move(refusal), snap});
+    for (auto& a : answers)
+      if (a.done) a.done({std::move(a.refusal), snap});
     if (sweep_ && sweep_->finished()) {
       finish_sweep(now_s);
       publish();
@@ -123,8 +135,8 @@ void BenchRuntime::run() {
     if (c.done) c.done({Refusal{Refused::shutting_down, "the daemon is stopping"}, snap});
 }
 
-std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime::act_on_commands(double now_s) {
-  std::vector<std::pair<Done, std::optional<Refusal>>> answers;
+std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s) {
+  std::vector<Answer> answers;
   std::size_t budget;
   {
     std::lock_guard lock(queue_mutex_);
@@ -132,12 +144,14 @@ std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime:
   }
   for (;;) {
     Command c;
+    bool urgent = false;
     {
       std::lock_guard lock(queue_mutex_);
       // An E-stop goes ahead of every command still queued.
       if (!estops_.empty()) {
         c = std::move(estops_.front());
         estops_.pop_front();
+        urgent = true;
       } else if (budget > 0 && !queue_.empty()) {
         c = std::move(queue_.front());
         queue_.pop_front();
@@ -146,7 +160,8 @@ std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime:
         break;
       }
     }
-    answers.emplace_back(std::move(c.done), c.act(now_s));
+    auto refusal = c.act(now_s);
+    answers.push_back({std::move(c.done), std::move(refusal), urgent});
   }
   return answers;
 }
@@ -190,6 +205,7 @@ void BenchRuntime::publish() {
   s.phase = supervisor_->phase();
   s.trip = supervisor_->trip();
   s.alarm = supervisor_->alarm();
+  s.disable = supervisor_->disable_report();
   s.ticks = ticks_;
   s.overruns = overruns_;
   s.events = events_;
@@ -262,9 +278,7 @@ void BenchRuntime::enable(bool on, Done done) {
         if (!failed) failed = apply_setpoints();
         if (!failed && (ec = dev.synrm->enable(true))) failed = device_error("enabling the SynRM drive", ec);
         if (failed) {
-          // Half a start is no state to leave a bench in.
-          dev.synrm->enable(false);
-          dev.load->enable(false);
+          // Half a start is no state to leave a bench in: the supervisor disables both.
           supervisor_->expect_stopped(now_s);
           return failed;
         }
@@ -438,12 +452,8 @@ void BenchRuntime::shutdown(std::chrono::milliseconds timeout) {
 
 void BenchRuntime::final_disable(double now_s) {
   if (sweep_) finish_sweep(now_s);
-  auto dev = backend_->devices();
-  const std::error_code ec_s = dev.synrm->enable(false);
-  const std::error_code ec_l = dev.load->enable(false);
-  if (ec_s) event("alarm", "final disable of the SynRM drive failed: " + ec_s.message());
-  if (ec_l) event("alarm", "final disable of the load drive failed: " + ec_l.message());
-  // Read back: the supervisor confirms both stopped, or raises its alarm.
+  // The supervisor disables both (its events say which failed), reads them back and confirms
+  // both stopped, or raises its alarm.
   supervisor_->expect_stopped(now_s);
   const double deadline_s = now_s + description_.limits.stop_confirm_s + 0.05;
   double t = now_s;

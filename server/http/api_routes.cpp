@@ -120,6 +120,23 @@ const char* phase_name(bench::SafetyPhase p) {
   return "?";
 }
 
+namespace {
+
+// A stop's disable per drive (bench/disable_report.hpp).
+nlohmann::json disable_json(const bench::DisableReport& r) {
+  const auto drive = [](const bench::DriveDisable& d) {
+    return nlohmann::json{{"state", std::string(bench::name(d.state))},
+                          {"first_acknowledged", d.first_acknowledged},
+                          {"attempts", d.attempts},
+                          {"error", d.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.error)},
+                          {"confirmed_s", d.confirmed_s ? nlohmann::json(*d.confirmed_s) : nlohmann::json(nullptr)},
+                          {"setpoint_zeroed", d.setpoint_zeroed}};
+  };
+  return {{"at_s", r.at_s}, {"confirmed", r.confirmed()}, {"synrm", drive(r.synrm)}, {"load", drive(r.load)}};
+}
+
+}  // namespace
+
 nlohmann::json status_json(const BenchStatus& s) {
   nlohmann::json j;
   j["t_s"] = s.t_s;
@@ -149,6 +166,7 @@ nlohmann::json status_json(const BenchStatus& s) {
   if (s.trip)
     j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))}, {"detail", s.trip->detail}, {"at_s", s.trip->at_s}};
   j["supervisor"]["alarm"] = s.alarm ? nlohmann::json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : nlohmann::json(nullptr);
+  j["supervisor"]["disable"] = s.disable ? disable_json(*s.disable) : nlohmann::json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
   if (s.sweep)
     j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
@@ -249,8 +267,10 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 return json_response(200, control->describe());
               }});
   router.add({"POST", "/api/bench/estop", Role::operator_,
-              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once and read back; "
-              "latched until reset. Answers once the bench has acted.",
+              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once (one request each), "
+              "then read back and the disable repeated every tick until both read stopped; latched until reset. Answers "
+              "once both disables were tried, with the status: supervisor.disable says per drive whether it was "
+              "acknowledged, is being repeated (and why) or is confirmed.",
               AsyncHandler([bench](const Request& req, Reply reply) {
                 bench->estop("E-stop (" + (req.caller_id.empty() ? std::string("REST") : req.caller_id) + ")",
                              answer(std::move(reply)));
