@@ -81,22 +81,18 @@ void BenchRuntime::run() {
       std::unique_lock lock(queue_mutex_);
       wake_.wait_until(lock, next, [this] { return !estops_.empty() || !queue_.empty(); });
     }
+    // E-stops before the clock's wait, which sends the heartbeats: on a dead line those alone
+    // take seconds, and nothing goes on the link ahead of an E-stop's disables.
+    if (estop_pending()) {
+      auto estops = act_on_commands(backend_->clock().now_s(), /*estops_only=*/true);
+      answer_estops(estops);
+    }
     const double target_s = base_s + std::chrono::duration<double>(clock::now() - t0).count();
     // Waiting on the twin's clock advances the simulation to the wall clock.
     if (target_s > backend_->clock().now_s()) backend_->clock().wait_until(target_s);
     const double now_s = backend_->clock().now_s();
     auto answers = act_on_commands(now_s);
-    // An E-stop is answered once both disables were tried, not after the tick's reads: on a
-    // starved line those may take seconds, and its snapshot already says per drive whether the
-    // disable was acknowledged or is being repeated (status.disable, until the read-back).
-    const auto estops_end = std::stable_partition(answers.begin(), answers.end(), [](const Answer& a) { return a.estop; });
-    if (estops_end != answers.begin()) {
-      publish();
-      const auto snap = snapshot();
-      for (auto it = answers.begin(); it != estops_end; ++it)
-        if (it->done) it->done({std::move(it->refusal), snap});
-      answers.erase(answers.begin(), estops_end);
-    }
+    answer_estops(answers);
     const bool due = clock::now() >= next;
     // A command is answered after a tick that read the drives back, not before.
     if (due || !answers.empty()) tick(now_s);
@@ -135,7 +131,20 @@ void BenchRuntime::run() {
     if (c.done) c.done({Refusal{Refused::shutting_down, "the daemon is stopping"}, snap});
 }
 
-std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s) {
+void BenchRuntime::answer_estops(std::vector<Answer>& answers) {
+  // An E-stop is answered once both disables were tried, not after the tick's reads: on a
+  // starved line those may take seconds, and its snapshot already says per drive whether the
+  // disable was acknowledged or is being repeated (status.disable, until the read-back).
+  const auto estops_end = std::stable_partition(answers.begin(), answers.end(), [](const Answer& a) { return a.estop; });
+  if (estops_end == answers.begin()) return;
+  publish();
+  const auto snap = snapshot();
+  for (auto it = answers.begin(); it != estops_end; ++it)
+    if (it->done) it->done({std::move(it->refusal), snap});
+  answers.erase(answers.begin(), estops_end);
+}
+
+std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s, bool estops_only) {
   std::vector<Answer> answers;
   std::size_t budget;
   {
@@ -152,7 +161,7 @@ std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s) {
         c = std::move(estops_.front());
         estops_.pop_front();
         urgent = true;
-      } else if (budget > 0 && !queue_.empty()) {
+      } else if (!estops_only && budget > 0 && !queue_.empty()) {
         c = std::move(queue_.front());
         queue_.pop_front();
         --budget;
@@ -169,6 +178,7 @@ std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s) {
 void BenchRuntime::tick(double now_s) {
   ++ticks_;
   backend_->tick(now_s);
+  if (estop_pending()) return;  // acted on at once, ahead of the reads
   supervisor_->tick(now_s);
   // An E-stop that arrived during the reads goes first: nothing else commands the drives.
   if (estop_pending()) return;

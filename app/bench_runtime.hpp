@@ -106,8 +106,11 @@ class BenchRuntime {
     std::optional<Refusal> refusal;
     bool estop = false;
   };
-  // Takes the queued commands (E-stops first) and acts on each; returns them for their answer.
-  std::vector<Answer> act_on_commands(double now_s);
+  // Takes the queued commands (E-stops first; only those when `estops_only`) and acts on each;
+  // returns them for their answer.
+  std::vector<Answer> act_on_commands(double now_s, bool estops_only = false);
+  // Answers the E-stops among `answers` now, with a fresh snapshot, and removes them.
+  void answer_estops(std::vector<Answer>& answers);
   void tick(double now_s);
   void publish();
   void event(const std::string& kind, const std::string& message);

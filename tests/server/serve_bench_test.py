@@ -327,7 +327,9 @@ def run_cut(tmp):
     (not faulted: the watchdog is 30 s here, so only the daemon's disable can have stopped them),
     the status says confirmed, and the setpoint registers read zero."""
     print("--- an E-stop on a dead RTU line")
-    cut_s = 1.5
+    # Longer than the tick in flight when the E-stop comes (every request of it times out) and
+    # the E-stop's two disables.
+    cut_s = 3.0
     pair = fs.SocatPair(tmp, "cut")
     emu = fs.Emulator(BIN, os.path.join(tmp, "cut_emulate.log"), rtu=pair.a,
                       args=["--watchdog-timeout-ms", "30000", "--duration-s", "900", "--fault-cut-s", str(cut_s)])
@@ -358,6 +360,8 @@ def run_cut(tmp):
                                          for d in ("synrm", "load")) and answer.get("confirmed") is False,
               "cut: its answer says neither disable was acknowledged and both are being repeated (%s)" % answer)
         time.sleep(max(0.0, cut_s + 0.1 - (time.monotonic() - pending.sent_at)))
+        far.close()
+        far = fs.ModbusTcp(emu.port, timeout=5.0)  # the cut closed the far side's connection too
         off = wait_for(lambda: far.states() == ((fs.DISABLED, 0), (fs.DISABLED, 0)), 2.0, 0.01)
         t_off = time.monotonic() - pending.sent_at
         check(off, "cut: once the line is back the repeated disable stops both drives (%.2f s after the E-stop): %s"
