@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <stdlib.h>
 #include <termios.h>
 #include <unistd.h>
@@ -35,7 +36,11 @@ std::vector<std::uint8_t> with_crc(std::vector<std::uint8_t> frame) {
   return frame;
 }
 
-// The master side of a pseudo-terminal: the bus opens the slave by its path.
+// The master side of a pseudo-terminal: the bus opens the slave by its path. In packet mode
+// (TIOCPKT) the master also learns of every flush the bus makes of its side: whether a request
+// still in the kernel's buffers was thrown away (TIOCPKT_FLUSHWRITE) is then seen for certain,
+// not only when the flush beats the kernel's delivery to this side (which a loaded machine, or
+// a real UART still sending, makes likely, and an idle test machine rare).
 class HandPlayedPeer {
  public:
   HandPlayedPeer() {
@@ -45,6 +50,8 @@ class HandPlayedPeer {
     ::tcgetattr(fd_, &t);
     ::cfmakeraw(&t);
     ::tcsetattr(fd_, TCSANOW, &t);
+    int on = 1;
+    if (::ioctl(fd_, TIOCPKT, &on) != 0) return;
     path_ = ::ptsname(fd_);
   }
   ~HandPlayedPeer() {
@@ -53,7 +60,8 @@ class HandPlayedPeer {
   bool ok() const { return !path_.empty(); }
   const std::string& path() const { return path_; }
   void send(const std::vector<std::uint8_t>& bytes) { ASSERT_EQ(::write(fd_, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size())); }
-  // Everything the bus has put on the line so far (waits up to `timeout_ms` for the first byte).
+  // Everything the bus has put on the line so far (waits up to `timeout_ms` for the first byte);
+  // the flushes it made are collected in flushes().
   std::vector<std::uint8_t> received(int timeout_ms = 100) {
     std::vector<std::uint8_t> out;
     for (;;) {
@@ -62,13 +70,23 @@ class HandPlayedPeer {
       std::uint8_t buf[256];
       const ssize_t n = ::read(fd_, buf, sizeof buf);
       if (n <= 0) return out;
-      out.insert(out.end(), buf, buf + n);
+      // Packet mode: a data packet starts with TIOCPKT_DATA (0), a status packet is one byte.
+      if (buf[0] == TIOCPKT_DATA) out.insert(out.end(), buf + 1, buf + n);
+      else flushes_ |= buf[0];
     }
+  }
+  // TIOCPKT_FLUSHREAD: the bus discarded its input; TIOCPKT_FLUSHWRITE: its output.
+  int flushes() const { return flushes_; }
+  // Forgets what came before (the bus's flush when it opens the port).
+  void forget() {
+    received(20);
+    flushes_ = 0;
   }
 
  private:
   int fd_ = -1;
   std::string path_;
+  int flushes_ = 0;
 };
 
 ModbusLinkOptions fast() {
@@ -91,14 +109,18 @@ TEST(ModbusRtuBus, ResynchronisingKeepsTheRequestJustSent) {
   port.device = peer.path();
   ModbusRtuBus bus(port, fast());
   ASSERT_FALSE(bus.connect()) << bus.last_error();
+  peer.forget();
   // The reply of an earlier "read holding 16+2" of unit 1, late.
   peer.send(with_crc({0x01, 0x03, 0x04, 0x44, 0x48, 0x00, 0x00}));
   const std::uint8_t off = 0;
   const std::error_code ec = bus.write_bits(1, 0, std::span(&off, 1));
   EXPECT_EQ(ec, make_error_code(errc::protocol)) << bus.last_error();
   EXPECT_EQ(bus.stats().protocol_errors, 1u);
-  // The disable (write single coil 0 of unit 1, off) is on the line, once.
+  // The disable (write single coil 0 of unit 1, off) is on the line, once; the bus flushed its
+  // input, never its output.
   EXPECT_EQ(peer.received(), with_crc({0x01, 0x05, 0x00, 0x00, 0x00, 0x00}));
+  EXPECT_TRUE(peer.flushes() & TIOCPKT_FLUSHREAD) << peer.flushes();
+  EXPECT_FALSE(peer.flushes() & TIOCPKT_FLUSHWRITE) << "the request just written was thrown away";
 }
 
 // What the resynchronisation must still discard: the late bytes themselves, so the next
@@ -110,6 +132,7 @@ TEST(ModbusRtuBus, ResynchronisingDiscardsTheLateReply) {
   port.device = peer.path();
   ModbusRtuBus bus(port, fast());
   ASSERT_FALSE(bus.connect()) << bus.last_error();
+  peer.forget();
   peer.send(with_crc({0x01, 0x03, 0x04, 0x44, 0x48, 0x00, 0x00}));
   peer.send(with_crc({0x01, 0x03, 0x04, 0x44, 0x49, 0x00, 0x00}));  // and another, in the same burst
   const std::uint8_t off = 0;
