@@ -1,6 +1,7 @@
 // The bench thread and its command queue; see bench_runtime.hpp.
 #include "app/bench_runtime.hpp"
 
+#include <algorithm>
 
 #include "app/plan_needs.hpp"
 #include "bench/load_ramp.hpp"
@@ -80,18 +81,25 @@ void BenchRuntime::run() {
       std::unique_lock lock(queue_mutex_);
       wake_.wait_until(lock, next, [this] { return !estops_.empty() || !queue_.empty(); });
     }
+    // E-stops before the clock's wait, which sends the heartbeats: on a dead line those alone
+    // take seconds, and nothing goes on the link ahead of an E-stop's disables.
+    if (estop_pending()) {
+      auto estops = act_on_commands(backend_->clock().now_s(), /*estops_only=*/true);
+      answer_estops(estops);
+    }
     const double target_s = base_s + std::chrono::duration<double>(clock::now() - t0).count();
     // Waiting on the twin's clock advances the simulation to the wall clock.
     if (target_s > backend_->clock().now_s()) backend_->clock().wait_until(target_s);
     const double now_s = backend_->clock().now_s();
     auto answers = act_on_commands(now_s);
+    answer_estops(answers);
     const bool due = clock::now() >= next;
     // A command is answered after a tick that read the drives back, not before.
     if (due || !answers.empty()) tick(now_s);
     publish();
     const auto snap = snapshot();
-    for (auto& [done, refusal] : answers)
-      if (done) done({std::move(refusal), snap});
+    for (auto& a : answers)
+      if (a.done) a.done({std::move(a.refusal), snap});
     if (sweep_ && sweep_->finished()) {
       finish_sweep(now_s);
       publish();
@@ -123,8 +131,21 @@ void BenchRuntime::run() {
     if (c.done) c.done({Refusal{Refused::shutting_down, "the daemon is stopping"}, snap});
 }
 
-std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime::act_on_commands(double now_s) {
-  std::vector<std::pair<Done, std::optional<Refusal>>> answers;
+void BenchRuntime::answer_estops(std::vector<Answer>& answers) {
+  // An E-stop is answered once both disables were tried, not after the tick's reads: on a
+  // starved line those may take seconds, and its snapshot already says per drive whether the
+  // disable was acknowledged or is being repeated (status.disable, until the read-back).
+  const auto estops_end = std::stable_partition(answers.begin(), answers.end(), [](const Answer& a) { return a.estop; });
+  if (estops_end == answers.begin()) return;
+  publish();
+  const auto snap = snapshot();
+  for (auto it = answers.begin(); it != estops_end; ++it)
+    if (it->done) it->done({std::move(it->refusal), snap});
+  answers.erase(answers.begin(), estops_end);
+}
+
+std::vector<BenchRuntime::Answer> BenchRuntime::act_on_commands(double now_s, bool estops_only) {
+  std::vector<Answer> answers;
   std::size_t budget;
   {
     std::lock_guard lock(queue_mutex_);
@@ -132,13 +153,15 @@ std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime:
   }
   for (;;) {
     Command c;
+    bool urgent = false;
     {
       std::lock_guard lock(queue_mutex_);
       // An E-stop goes ahead of every command still queued.
       if (!estops_.empty()) {
         c = std::move(estops_.front());
         estops_.pop_front();
-      } else if (budget > 0 && !queue_.empty()) {
+        urgent = true;
+      } else if (!estops_only && budget > 0 && !queue_.empty()) {
         c = std::move(queue_.front());
         queue_.pop_front();
         --budget;
@@ -146,7 +169,8 @@ std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime:
         break;
       }
     }
-    answers.emplace_back(std::move(c.done), c.act(now_s));
+    auto refusal = c.act(now_s);
+    answers.push_back({std::move(c.done), std::move(refusal), urgent});
   }
   return answers;
 }
@@ -154,6 +178,7 @@ std::vector<std::pair<BenchRuntime::Done, std::optional<Refusal>>> BenchRuntime:
 void BenchRuntime::tick(double now_s) {
   ++ticks_;
   backend_->tick(now_s);
+  if (estop_pending()) return;  // acted on at once, ahead of the reads
   supervisor_->tick(now_s);
   // An E-stop that arrived during the reads goes first: nothing else commands the drives.
   if (estop_pending()) return;
@@ -190,6 +215,7 @@ void BenchRuntime::publish() {
   s.phase = supervisor_->phase();
   s.trip = supervisor_->trip();
   s.alarm = supervisor_->alarm();
+  s.disable = supervisor_->disable_report();
   s.ticks = ticks_;
   s.overruns = overruns_;
   s.events = events_;
@@ -262,9 +288,7 @@ void BenchRuntime::enable(bool on, Done done) {
         if (!failed) failed = apply_setpoints();
         if (!failed && (ec = dev.synrm->enable(true))) failed = device_error("enabling the SynRM drive", ec);
         if (failed) {
-          // Half a start is no state to leave a bench in.
-          dev.synrm->enable(false);
-          dev.load->enable(false);
+          // Half a start is no state to leave a bench in: the supervisor disables both.
           supervisor_->expect_stopped(now_s);
           return failed;
         }
@@ -438,12 +462,8 @@ void BenchRuntime::shutdown(std::chrono::milliseconds timeout) {
 
 void BenchRuntime::final_disable(double now_s) {
   if (sweep_) finish_sweep(now_s);
-  auto dev = backend_->devices();
-  const std::error_code ec_s = dev.synrm->enable(false);
-  const std::error_code ec_l = dev.load->enable(false);
-  if (ec_s) event("alarm", "final disable of the SynRM drive failed: " + ec_s.message());
-  if (ec_l) event("alarm", "final disable of the load drive failed: " + ec_l.message());
-  // Read back: the supervisor confirms both stopped, or raises its alarm.
+  // The supervisor disables both (its events say which failed), reads them back and confirms
+  // both stopped, or raises its alarm.
   supervisor_->expect_stopped(now_s);
   const double deadline_s = now_s + description_.limits.stop_confirm_s + 0.05;
   double t = now_s;

@@ -4,8 +4,10 @@
 // touches a device: commands (enable, setpoints, mode, reset, sweeps) are messages queued to the
 // bench thread, acted on there, and answered through their callback once acted on. An E-stop
 // goes ahead of everything queued and wakes the thread at once: it stops the watchdog heartbeats
-// (so the drives' own watchdogs are the second line), disables both drives, and the supervisor
-// reads them back and latches an alarm if one still runs. Free of HTTP and of the twin.
+// (so the drives' own watchdogs are the second line), disables both drives (each request once)
+// and is answered right then, before the tick's reads: its snapshot says what each drive made of
+// its disable (status.disable), and the supervisor repeats it every tick until both read back
+// stopped, latching an alarm if one still runs. Free of HTTP and of the twin.
 #pragma once
 
 #include <chrono>
@@ -99,8 +101,16 @@ class BenchRuntime {
   };
   void submit(Act act, Done done, bool urgent = false);
   void run();
-  // Takes the queued commands (E-stops first) and acts on each; returns them for their answer.
-  std::vector<std::pair<Done, std::optional<Refusal>>> act_on_commands(double now_s);
+  struct Answer {
+    Done done;
+    std::optional<Refusal> refusal;
+    bool estop = false;
+  };
+  // Takes the queued commands (E-stops first; only those when `estops_only`) and acts on each;
+  // returns them for their answer.
+  std::vector<Answer> act_on_commands(double now_s, bool estops_only = false);
+  // Answers the E-stops among `answers` now, with a fresh snapshot, and removes them.
+  void answer_estops(std::vector<Answer>& answers);
   void tick(double now_s);
   void publish();
   void event(const std::string& kind, const std::string& message);

@@ -61,6 +61,7 @@ struct BenchStatus {
   bench::SafetyPhase phase = bench::SafetyPhase::normal;
   std::optional<bench::SafetyTrip> trip;
   std::optional<bench::SafetyAlarm> alarm;
+  std::optional<bench::DisableReport> disable;  // the last stop's disable, per drive, until a reset
   std::uint64_t ticks = 0;
   std::uint64_t overruns = 0;  // ticks that started more than one period late
   std::deque<BenchEvent> events;  // the most recent supervisor and command events

@@ -48,29 +48,72 @@ void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string det
   phase_ = SafetyPhase::stopping_load;
 }
 
-void SafetySupervisor::disable_all() {
-  // Both are always tried: a failed SynRM disable must not keep the load's from being sent.
-  const std::error_code ec_s = dev_.synrm->enable(false);
-  const std::error_code ec_l = dev_.load->enable(false);
-  if (sink_ && ec_s) sink_("fault", "disabling the SynRM drive failed: " + ec_s.message());
-  if (sink_ && ec_l) sink_("fault", "disabling the load drive failed: " + ec_l.message());
+namespace {
+
+std::string failure(std::error_code ec, const std::string& detail) {
+  return ec.message() + (detail.empty() ? "" : " (" + detail + ")");
+}
+
+// One disable request to one drive, its answer kept.
+template <class Drive>
+void send_disable(Drive& drive, DriveDisable& d) {
+  const std::error_code ec = drive.disable_once();
+  ++d.attempts;
+  if (ec) {
+    d.state = DisableState::repeating;
+    d.error = "disable not acknowledged: " + failure(ec, drive.error_detail());
+  } else if (d.state != DisableState::confirmed) {
+    d.state = DisableState::acknowledged;
+  }
+}
+
+}  // namespace
+
+void SafetySupervisor::disable_all(double now_s) {
+  // Both are always tried, each once: a failed SynRM disable must not keep the load's from
+  // being sent, nor its repeats inside one call delay it. The repeats come every tick.
+  report_ = DisableReport{};
+  report_->at_s = now_s;
+  send_disable(*dev_.synrm, report_->synrm);
+  send_disable(*dev_.load, report_->load);
+  report_->synrm.first_acknowledged = report_->synrm.state == DisableState::acknowledged;
+  report_->load.first_acknowledged = report_->load.state == DisableState::acknowledged;
+  const auto tell = [this](const char* which, const DriveDisable& d) {
+    if (sink_ && !d.first_acknowledged)
+      sink_("fault", std::string("disabling the ") + which + " drive failed: " + d.error +
+                         "; repeated every tick until it reads back disabled");
+  };
+  tell("SynRM", report_->synrm);
+  tell("load", report_->load);
+  if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
+}
+
+void SafetySupervisor::repeat_disables() {
+  if (!confirm_deadline_s_ || !report_) return;
+  if (report_->synrm.state == DisableState::repeating) send_disable(*dev_.synrm, report_->synrm);
+  if (report_->load.state == DisableState::repeating) send_disable(*dev_.load, report_->load);
+}
+
+void SafetySupervisor::zero_setpoints() {
+  if (!report_) return;
+  // Only once the disable went through: a setpoint write never goes ahead of a disable.
+  const auto through = [](const DriveDisable& d) { return d.state != DisableState::repeating && !d.setpoint_zeroed; };
+  if (through(report_->synrm)) report_->synrm.setpoint_zeroed = !dev_.synrm->set_speed_rpm(0.0);
+  if (through(report_->load)) report_->load.setpoint_zeroed = !dev_.load->set_torque_Nm(0.0);
 }
 
 void SafetySupervisor::estop(double now_s, const std::string& why) {
   stop_.cancel();
-  disable_all();
+  disable_all(now_s);
   if (!trip_) {
     trip_ = SafetyTrip{drivers::Fault::estop, why, now_s, std::nullopt};
     if (sink_) sink_("fault", "estop: " + why);
   }
   phase_ = SafetyPhase::estopped;
   stop_duration_s_ = 0.0;
-  expect_stopped(now_s);
 }
 
-void SafetySupervisor::expect_stopped(double now_s) {
-  if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
-}
+void SafetySupervisor::expect_stopped(double now_s) { disable_all(now_s); }
 
 std::string SafetySupervisor::unconfirmed() const {
   std::string s;
@@ -84,15 +127,37 @@ std::string SafetySupervisor::unconfirmed() const {
 
 void SafetySupervisor::confirm_stop(double now_s) {
   if (!confirm_deadline_s_) return;
+  const auto check = [&](const char* which, DriveDisable& d, bool read, bool runs, const std::string& read_error) {
+    if (read && !runs) {
+      if (d.state == DisableState::confirmed) return;
+      if (sink_ && (!d.first_acknowledged || d.attempts > 1))
+        sink_("state", std::string("the ") + which + " drive reads back disabled after " + std::to_string(d.attempts) +
+                           " disable requests");
+      d.state = DisableState::confirmed;
+      d.confirmed_s = now_s;
+      d.error.clear();
+      return;
+    }
+    // A disable lost on the link, or a drive that ignored it: repeated at the next tick's start,
+    // also to a drive that cannot be read (a disable is harmless to repeat, and a flaky line may
+    // carry it).
+    d.state = DisableState::repeating;
+    d.error = read ? "still reports running" : "cannot be read back: " + read_error;
+  };
+  if (report_) {
+    check("SynRM", report_->synrm, synrm_.has_value(), synrm_ && drivers::running(synrm_->state), synrm_read_error_);
+    check("load", report_->load, load_.has_value(), load_ && drivers::running(load_->state), load_read_error_);
+    zero_setpoints();
+  }
   const std::string running = unconfirmed();
   if (running.empty()) {
+    // Tried no longer than the stop is confirmed: once it is, the bench may be enabled again
+    // with setpoints of its own.
+    if (sink_ && report_ && !(report_->synrm.setpoint_zeroed && report_->load.setpoint_zeroed))
+      sink_("fault", "the setpoints could not be written to zero after the disable (the drives read back disabled)");
     confirm_deadline_s_.reset();
     return;
   }
-  // A disable lost on the link, or a drive that ignored it: say it again every tick, also to a
-  // drive that cannot be read (a disable is harmless to repeat, and a flaky line may carry it).
-  if (!synrm_ || drivers::running(synrm_->state)) dev_.synrm->enable(false);
-  if (!load_ || drivers::running(load_->state)) dev_.load->enable(false);
   if (alarm_ || now_s < *confirm_deadline_s_) return;
   char when[48];
   std::snprintf(when, sizeof when, " %.2f s after the disable", now_s - (*confirm_deadline_s_ - lim_.stop_confirm_s));
@@ -113,6 +178,7 @@ std::error_code SafetySupervisor::reset() {
   trip_.reset();
   alarm_.reset();
   confirm_deadline_s_.reset();
+  report_.reset();
   stop_duration_s_.reset();
   plausibility_.reset();
   phase_ = SafetyPhase::normal;
@@ -120,10 +186,13 @@ std::error_code SafetySupervisor::reset() {
 }
 
 void SafetySupervisor::tick(double now_s) {
+  repeat_disables();
   drivers::SynrmTelemetry st;
   drivers::LoadTelemetry lt;
   const std::error_code ec_s = dev_.synrm->read(st);
+  synrm_read_error_ = ec_s ? failure(ec_s, dev_.synrm->error_detail()) : std::string();
   const std::error_code ec_l = dev_.load->read(lt);
+  load_read_error_ = ec_l ? failure(ec_l, dev_.load->error_detail()) : std::string();
   synrm_.reset();
   load_.reset();
   if (!ec_s) synrm_ = st;

@@ -1,10 +1,14 @@
 // Safety supervisor of the bench: checked every tick, whatever a sweep is doing. On a limit
 // violation, a device fault or a lost link it brings the bench to the ordered stop — load torque
 // to zero, then speed to zero, then both drives disabled — and latches the reason until an
-// explicit reset; an E-stop disables both drives at once. Every disable's result is checked and
-// the drives' state is read back: a drive that still reports running (or cannot be read) after
-// `stop_confirm_s` latches a loud alarm, and its disable is repeated every tick until it stops.
-// Pure logic on the time it is given.
+// explicit reset; an E-stop disables both drives at once. Every stop ends in the supervisor's own
+// disable of both drives (each tried once before either is tried again), whose result is kept
+// drive by drive (disable_report.hpp) and checked by reading the drives back: a drive whose
+// disable was not acknowledged, or that still reads running or cannot be read, has its disable
+// repeated at the start of every tick, before the tick's reads (on a starved line the reads may
+// all time out first); after `stop_confirm_s` it latches a loud alarm. Once a drive's disable
+// went through, its setpoint (speed, load torque) is written to zero. Pure logic on the time it
+// is given.
 #pragma once
 
 #include <functional>
@@ -12,6 +16,7 @@
 #include <string>
 #include <system_error>
 
+#include "bench/disable_report.hpp"
 #include "bench/ordered_stop.hpp"
 #include "bench/telemetry_plausibility.hpp"
 #include "drivers/devices.hpp"
@@ -65,11 +70,15 @@ class SafetySupervisor {
   const std::optional<drivers::SynrmTelemetry>& synrm() const { return synrm_; }
   const std::optional<drivers::LoadTelemetry>& load() const { return load_; }
 
-  // Immediate disable of both drives; latched like any trip.
+  // Immediate disable of both drives (each request once: the caller's answer may follow at
+  // once, disable_report() says what each drive made of it); latched like any trip.
   void estop(double now_s, const std::string& why = "E-stop");
   // Someone else's ordered stop (a user's disable, a sweep's end) has just disabled the drives:
-  // confirm it by reading them back, as after a trip.
+  // the supervisor sends its own disable (harmless twice; so it knows each drive's answer) and
+  // confirms it by reading them back, as after a trip.
   void expect_stopped(double now_s);
+  // The last stop's disable, drive by drive; empty before the first stop and after a reset.
+  const std::optional<DisableReport>& disable_report() const { return report_; }
   // Explicit reset: clears the latch and the devices' latched faults. Refused while an ordered
   // stop is still running, or while a drive still reads back running after a stop (errc::busy).
   // Never restarts anything.
@@ -94,8 +103,10 @@ class SafetySupervisor {
   void raise(double now_s, drivers::Fault fault, std::string detail,
              std::optional<std::int64_t> fault_code_raw = std::nullopt);
   void advance_stop(double now_s);
-  void disable_all();
+  void disable_all(double now_s);
+  void repeat_disables();
   void confirm_stop(double now_s);
+  void zero_setpoints();
 
   drivers::BenchDevices dev_;
   SafetyLimits lim_;
@@ -109,6 +120,8 @@ class SafetySupervisor {
   std::optional<SafetyTrip> trip_;
   std::optional<SafetyAlarm> alarm_;
   std::optional<double> confirm_deadline_s_;
+  std::optional<DisableReport> report_;
+  std::string synrm_read_error_, load_read_error_;  // of this tick's reads
   std::optional<double> stop_duration_s_;
   TelemetryPlausibility plausibility_;
 };

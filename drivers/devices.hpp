@@ -89,6 +89,9 @@ class SynrmDrive {
  public:
   virtual ~SynrmDrive() = default;
   virtual std::error_code enable(bool on) = 0;
+  // One disable request, not repeated inside the call when it is lost: a stop of both drives
+  // has each tried once before either is tried again (the safety supervisor repeats it).
+  virtual std::error_code disable_once() { return enable(false); }
   virtual std::error_code set_speed_rpm(double speed_rpm) = 0;
   virtual std::error_code set_angle_deg(double angle_deg) = 0;
   virtual std::error_code set_pwm(Pwm pwm) = 0;
@@ -120,6 +123,7 @@ class LoadDrive {
  public:
   virtual ~LoadDrive() = default;
   virtual std::error_code enable(bool on) = 0;
+  virtual std::error_code disable_once() { return enable(false); }  // as SynrmDrive's
   // Braking torque magnitude; the drive applies it against the direction of rotation.
   virtual std::error_code set_torque_Nm(double torque_Nm) = 0;
   virtual std::error_code reset_fault() = 0;

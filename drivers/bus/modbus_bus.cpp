@@ -3,6 +3,7 @@
 
 #include <modbus.h>
 #include <poll.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -242,10 +243,13 @@ ModbusRtuBus::ModbusRtuBus(const RtuPort& port, const ModbusLinkOptions& options
 void ModbusRtuBus::resynchronize() {
   // RTU replies carry no transaction id: a late reply taken for the next one would be a wrong
   // value. Discard what is buffered, then whatever arrives until the line has been quiet.
+  // The input only: modbus_flush (TCIOFLUSH) also throws away the request just written while the
+  // peer has not taken it yet (a pty's far end, a USB adapter still sending), and a late reply
+  // arrives right after a write: that lost a drive's disable on every repeat that met one.
   modbus_t* ctx = context();
-  modbus_flush(ctx);
   const int fd = modbus_get_socket(ctx);
   if (fd < 0) return;
+  ::tcflush(fd, TCIFLUSH);
   const int quiet_ms = std::max(1, static_cast<int>(std::lround(options().rtu_quiet_s * 1000)));
   const auto give_up = std::chrono::steady_clock::now() +
                        std::chrono::duration<double>(4 * options().rtu_quiet_s + 4 * options().response_timeout_s);

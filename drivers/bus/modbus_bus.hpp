@@ -3,7 +3,7 @@
 // and recovered here within bounded time:
 //  - timeout or malformed reply on TCP: the connection is closed and the next request opens a
 //    fresh one, so a late reply can never be taken for the answer to a later request;
-//  - timeout or malformed reply on RTU (no transaction ids on a serial line): the port is
+//  - timeout or malformed reply on RTU (no transaction ids on a serial line): the port's input is
 //    flushed and the line drained until it has been quiet for `rtu_quiet_s`;
 //  - link failure (reset, refused, I/O error): closed, and reconnected with bounded exponential
 //    backoff; calls during the backoff fail at once with errc::disconnected.

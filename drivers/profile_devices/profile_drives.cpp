@@ -94,6 +94,7 @@ ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
       host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileSynrmDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
+std::error_code ProfileSynrmDrive::disable_once() { return io().write_once("enable", 0); }
 std::error_code ProfileSynrmDrive::set_speed_rpm(double v) { return io().write("speed_setpoint_rpm", v); }
 std::error_code ProfileSynrmDrive::set_angle_deg(double v) { return io().write("angle_setpoint_deg", v); }
 std::error_code ProfileSynrmDrive::reset_fault() { return pulse_fault_reset(); }
@@ -217,6 +218,7 @@ ProfileLoadDrive::ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile)
       host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileLoadDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
+std::error_code ProfileLoadDrive::disable_once() { return io().write_once("enable", 0); }
 std::error_code ProfileLoadDrive::set_torque_Nm(double v) { return io().write("torque_setpoint_Nm", v); }
 std::error_code ProfileLoadDrive::reset_fault() { return pulse_fault_reset(); }
 

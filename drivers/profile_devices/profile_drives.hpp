@@ -67,6 +67,7 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile);
 
   std::error_code enable(bool on) override;
+  std::error_code disable_once() override;
   std::error_code set_speed_rpm(double speed_rpm) override;
   std::error_code set_angle_deg(double angle_deg) override;
   // A profile without pwm_scheme (or estimator) accepts only the default (capwm, encoder): a
@@ -91,6 +92,7 @@ class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
   ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile);
 
   std::error_code enable(bool on) override;
+  std::error_code disable_once() override;
   std::error_code set_torque_Nm(double torque_Nm) override;
   std::error_code reset_fault() override;
   std::error_code read(LoadTelemetry& out) override;

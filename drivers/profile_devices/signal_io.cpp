@@ -204,13 +204,17 @@ std::error_code SignalIo::write_masked(const ProfileSignal& s, double device_val
   return {};
 }
 
-std::error_code SignalIo::write(std::string_view signal, double value) {
+std::error_code SignalIo::write(std::string_view signal, double value) { return write(signal, value, true); }
+
+std::error_code SignalIo::write_once(std::string_view signal, double value) { return write(signal, value, false); }
+
+std::error_code SignalIo::write(std::string_view signal, double value, bool repeat) {
   const ProfileSignal* s = profile_.find(signal);
   if (!s || !s->writable() || !is_writable_kind(s->kind)) return make_error_code(errc::not_supported);
   double device_value = 0;
   if (auto ec = to_device_value(profile_.kind, *s, value, device_value))
     return fail(ec, s, "the device has no code for bench code " + format_number(value));
-  const bool idempotent = s->role != SignalRole::window_start;
+  const bool idempotent = repeat && s->role != SignalRole::window_start;
   std::error_code ec;
   if (s->masked()) {
     ec = write_masked(*s, device_value, idempotent);

@@ -93,6 +93,9 @@ class SignalIo {
   // signal is a read-modify-write of its register: the other signals' bits are kept.
   // errc::not_supported when the profile does not map the signal.
   std::error_code write(std::string_view signal, double value);
+  // As write(), one request only, whatever the retry policy (a masked signal's read before it
+  // may still be repeated): for a caller that repeats it itself, after other devices had theirs.
+  std::error_code write_once(std::string_view signal, double value);
   // The last value written to `signal` (bench units), if any.
   std::optional<double> last_written(std::string_view signal) const;
 
@@ -105,6 +108,7 @@ class SignalIo {
   std::error_code with_retries(bool idempotent, Request&& request);
   // Decodes one signal of a completed read; on failure sets last_error_.
   std::error_code decode(const ProfileSignal& s, std::size_t at, double& bench_value, double& device_value);
+  std::error_code write(std::string_view signal, double value, bool repeat);
   std::error_code write_masked(const ProfileSignal& s, double device_value, bool idempotent);
   std::error_code fail(std::error_code ec, const ProfileSignal* s, std::string what);
   std::string device() const;

@@ -122,6 +122,19 @@ const char* phase_name(bench::SafetyPhase p) {
 
 namespace {
 
+// A stop's disable per drive (bench/disable_report.hpp).
+nlohmann::json disable_json(const bench::DisableReport& r) {
+  const auto drive = [](const bench::DriveDisable& d) {
+    return nlohmann::json{{"state", std::string(bench::name(d.state))},
+                          {"first_acknowledged", d.first_acknowledged},
+                          {"attempts", d.attempts},
+                          {"error", d.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.error)},
+                          {"confirmed_s", d.confirmed_s ? nlohmann::json(*d.confirmed_s) : nlohmann::json(nullptr)},
+                          {"setpoint_zeroed", d.setpoint_zeroed}};
+  };
+  return {{"at_s", r.at_s}, {"confirmed", r.confirmed()}, {"synrm", drive(r.synrm)}, {"load", drive(r.load)}};
+}
+
 // A drive's own code of a fault its profile has no label for (fault "unknown"), else null.
 nlohmann::json raw_code(const std::optional<std::int64_t>& code) {
   return code ? nlohmann::json(*code) : nlohmann::json(nullptr);
@@ -131,6 +144,19 @@ nlohmann::json object_schema(nlohmann::json properties, bool nullable = false) {
   nlohmann::json o = {{"type", "object"}, {"properties", std::move(properties)}};
   if (nullable) o["nullable"] = true;
   return o;
+}
+
+// disable_json()'s object for the OpenAPI document: null until a stop's disable was sent.
+nlohmann::json disable_schema() {
+  const nlohmann::json str = {{"type", "string"}}, boolean = {{"type", "boolean"}};
+  const nlohmann::json drive = object_schema(
+      {{"state", {{"type", "string"}, {"enum", {"acknowledged", "repeating", "confirmed"}}}},
+       {"first_acknowledged", boolean},
+       {"attempts", {{"type", "integer"}}},
+       {"error", {{"type", "string"}, {"nullable", true}}},
+       {"confirmed_s", {{"type", "number"}, {"nullable", true}}},
+       {"setpoint_zeroed", boolean}});
+  return object_schema({{"at_s", {{"type", "number"}}}, {"confirmed", boolean}, {"synrm", drive}, {"load", drive}}, true);
 }
 
 // The status object of status_json() for the OpenAPI document (docs/api.md, "Status").
@@ -159,7 +185,8 @@ nlohmann::json status_schema() {
         object_schema({{"phase", str},
                        {"tripped", boolean},
                        {"trip", object_schema({{"fault", str}, {"fault_code_raw", code_raw}, {"detail", str}, {"at_s", num}})},
-                       {"alarm", object_schema({{"detail", str}, {"at_s", num}}, true)}})},
+                       {"alarm", object_schema({{"detail", str}, {"at_s", num}}, true)},
+                       {"disable", disable_schema()}})},
        {"loop", object_schema({{"ticks", {{"type", "integer"}}}, {"overruns", {{"type", "integer"}}}})},
        {"sweep", object_schema({{"id", {{"type", "integer"}}}, {"state", str}, {"done", {{"type", "integer"}}},
                                 {"total", {{"type", "integer"}}}, {"error", str}},
@@ -203,6 +230,7 @@ nlohmann::json status_json(const BenchStatus& s) {
                                {"detail", s.trip->detail},
                                {"at_s", s.trip->at_s}};
   j["supervisor"]["alarm"] = s.alarm ? nlohmann::json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : nlohmann::json(nullptr);
+  j["supervisor"]["disable"] = s.disable ? disable_json(*s.disable) : nlohmann::json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
   if (s.sweep)
     j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
@@ -305,8 +333,10 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 return json_response(200, control->describe());
               }});
   router.add({"POST", "/api/bench/estop", Role::operator_,
-              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once and read back; "
-              "latched until reset. Answers once the bench has acted.",
+              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once (one request each), "
+              "then read back and the disable repeated every tick until both read stopped; latched until reset. Answers "
+              "once both disables were tried, with the status: supervisor.disable says per drive whether it was "
+              "acknowledged, is being repeated (and why) or is confirmed.",
               AsyncHandler([bench](const Request& req, Reply reply) {
                 bench->estop("E-stop (" + (req.caller_id.empty() ? std::string("REST") : req.caller_id) + ")",
                              answer(std::move(reply)));

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <future>
@@ -104,6 +105,99 @@ TEST(BenchRuntime, ACommandIsAnsweredAfterTheBenchActedAndEveryOneAtTheShutdown)
   ASSERT_TRUE(s.synrm);
   EXPECT_FALSE(drivers::running(s.synrm->state)) << "the shutdown ends with the drives read back disabled";
   EXPECT_FALSE(s.alarm);
+}
+
+// The twin's drives, whose reads take `slow_read_s` of wall time each once a disable was sent:
+// a starved line, where every read of the tick times out.
+class SlowReadsAfterDisable final : public BenchBackend {
+ public:
+  SlowReadsAfterDisable() : twin_(emulator::TwinConfig{}), synrm_(*this, *twin_.devices().synrm), load_(*this, *twin_.devices().load) {}
+  drivers::BenchDevices devices() override {
+    auto d = twin_.devices();
+    d.synrm = &synrm_;
+    d.load = &load_;
+    return d;
+  }
+  drivers::Clock& clock() override { return twin_.clock(); }
+  nlohmann::json describe() const override { return nlohmann::json::array(); }
+  const BenchDescription& description() const override { return description_; }
+  std::atomic<double> slow_read_s{0.3};
+  std::atomic<bool> disabled{false};
+
+ private:
+  void maybe_slow() {
+    if (disabled) std::this_thread::sleep_for(std::chrono::duration<double>(slow_read_s.load()));
+  }
+  struct Synrm final : drivers::SynrmDrive {
+    SlowReadsAfterDisable& b;
+    drivers::SynrmDrive& d;
+    Synrm(SlowReadsAfterDisable& bb, drivers::SynrmDrive& dd) : b(bb), d(dd) {}
+    std::error_code enable(bool on) override {
+      if (!on) b.disabled = true;
+      return d.enable(on);
+    }
+    std::error_code set_speed_rpm(double v) override { return d.set_speed_rpm(v); }
+    std::error_code set_angle_deg(double v) override { return d.set_angle_deg(v); }
+    std::error_code set_pwm(drivers::Pwm p) override { return d.set_pwm(p); }
+    std::error_code set_estimator(drivers::Estimator e) override { return d.set_estimator(e); }
+    std::error_code reset_fault() override { return d.reset_fault(); }
+    std::error_code read(drivers::SynrmTelemetry& out) override {
+      b.maybe_slow();
+      return d.read(out);
+    }
+    std::error_code read_window(drivers::SynrmWindow& out) override { return d.read_window(out); }
+  };
+  struct Load final : drivers::LoadDrive {
+    SlowReadsAfterDisable& b;
+    drivers::LoadDrive& d;
+    Load(SlowReadsAfterDisable& bb, drivers::LoadDrive& dd) : b(bb), d(dd) {}
+    std::error_code enable(bool on) override { return d.enable(on); }
+    std::error_code set_torque_Nm(double v) override { return d.set_torque_Nm(v); }
+    std::error_code reset_fault() override { return d.reset_fault(); }
+    std::error_code read(drivers::LoadTelemetry& out) override {
+      b.maybe_slow();
+      return d.read(out);
+    }
+    std::error_code read_window(drivers::LoadWindow& out) override { return d.read_window(out); }
+  };
+  emulator::TwinBench twin_;
+  BenchDescription description_;
+  Synrm synrm_;
+  Load load_;
+};
+
+// An E-stop is answered once both disables were tried, before the tick's reads (which a starved
+// line can stretch to seconds), and its answer says per drive what became of the disable; the
+// status says "confirmed" once the read-back has seen both stopped.
+TEST(BenchRuntime, AnEstopIsAnsweredAfterItsDisablesNotAfterTheReads) {
+  auto owned = std::make_unique<SlowReadsAfterDisable>();
+  SlowReadsAfterDisable* backend = owned.get();
+  BenchRuntime rt(std::move(owned));
+  rt.start();
+  Answers a;
+  rt.set_setpoints({300.0, 0.0, 50.0}, a.done("setpoints"));
+  rt.enable(true, a.done("enable"));
+  ASSERT_TRUE(wait_for([&] { return a.size() == 2; }, 5.0));
+  ASSERT_FALSE(a.got[1].second.refusal);
+  const auto sent = std::chrono::steady_clock::now();
+  std::promise<Outcome> answered;
+  rt.estop("test", [&](Outcome o) { answered.set_value(std::move(o)); });
+  auto fut = answered.get_future();
+  ASSERT_EQ(fut.wait_for(std::chrono::seconds(5)), std::future_status::ready);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  EXPECT_LT(took_s, backend->slow_read_s.load()) << "answered without waiting on the reads";
+  const Outcome o = fut.get();
+  ASSERT_FALSE(o.refusal);
+  const auto& d = o.snapshot->status.disable;
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->synrm.state, bench::DisableState::acknowledged);
+  EXPECT_TRUE(d->synrm.first_acknowledged);
+  EXPECT_EQ(d->load.state, bench::DisableState::acknowledged);
+  EXPECT_FALSE(d->confirmed()) << "not read back yet: not claimed";
+  EXPECT_EQ(o.snapshot->status.phase, bench::SafetyPhase::estopped);
+  ASSERT_TRUE(wait_for([&] { return rt.snapshot()->status.disable && rt.snapshot()->status.disable->confirmed(); }, 5.0));
+  backend->slow_read_s = 0;
+  rt.shutdown();
 }
 
 // A plan's limits bind the daemon's sweep as they bind `synbench sweep`: 0.5 A trips a point

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -150,6 +151,8 @@ struct RecordingBench {
   double t = 0;
   bool ignore_synrm_disable = false;
   int synrm_disables = 0;
+  int lose_synrm_disables = 0;  // the next this many SynRM disables are lost on the link (timeout)
+  bool refuse_load_torque = false;
   void note(const char* what, double v) {
     const auto snap = bench.twin().snapshot();
     log.push_back({what, v, t, snap.speed_rpm, snap.load_torque_Nm});
@@ -161,6 +164,10 @@ struct RecordingBench {
     std::error_code enable(bool on) override {
       r.note("synrm.enable", on);
       if (!on) ++r.synrm_disables;
+      if (!on && r.lose_synrm_disables > 0) {
+        --r.lose_synrm_disables;
+        return make_error_code(errc::timeout);
+      }
       if (!on && r.ignore_synrm_disable) return {};
       return d.enable(on);
     }
@@ -172,7 +179,10 @@ struct RecordingBench {
     std::error_code set_pwm(drivers::Pwm p) override { return d.set_pwm(p); }
     std::error_code set_estimator(drivers::Estimator e) override { return d.set_estimator(e); }
     std::error_code reset_fault() override { return d.reset_fault(); }
-    std::error_code read(drivers::SynrmTelemetry& out) override { return d.read(out); }
+    std::error_code read(drivers::SynrmTelemetry& out) override {
+      r.note("synrm.read", 0);
+      return d.read(out);
+    }
     std::error_code read_window(drivers::SynrmWindow& out) override { return d.read_window(out); }
   } synrm{*this, *bench.devices().synrm};
   struct Load final : drivers::LoadDrive {
@@ -185,6 +195,7 @@ struct RecordingBench {
     }
     std::error_code set_torque_Nm(double v) override {
       r.note("load.torque", v);
+      if (r.refuse_load_torque) return make_error_code(errc::exception_reply);
       return d.set_torque_Nm(v);
     }
     std::error_code reset_fault() override { return d.reset_fault(); }
@@ -244,9 +255,10 @@ TEST(SafetySupervisor, TheOrderedStopTakesTheLoadThenTheSpeedThenDisables) {
   EXPECT_EQ(r.sup.trip()->fault, drivers::Fault::overtemperature);
   const std::vector<SafetyPhase> expected = {SafetyPhase::stopping_load, SafetyPhase::stopping_speed, SafetyPhase::stopped};
   EXPECT_EQ(phases, expected);
-  ASSERT_FALSE(r.log.empty());
-  EXPECT_EQ(r.log.front().what, "load.torque") << "the first command after the trip";
-  EXPECT_EQ(r.log.front().value, 0.0);
+  const auto command = std::find_if(r.log.begin(), r.log.end(), [](const Recorded& x) { return x.what != "synrm.read"; });
+  ASSERT_NE(command, r.log.end());
+  EXPECT_EQ(command->what, "load.torque") << "the first command after the trip";
+  EXPECT_EQ(command->value, 0.0);
   const auto* speed0 = r.first("synrm.speed", 0.0);
   const auto* off_s = r.first("synrm.enable", 0.0);
   const auto* off_l = r.first("load.enable", 0.0);
@@ -288,6 +300,102 @@ TEST(SafetySupervisor, ADriveThatIgnoresItsDisableRaisesTheAlarm) {
   EXPECT_FALSE(r.sup.reset());
   EXPECT_FALSE(r.sup.alarm());
   EXPECT_FALSE(r.sup.tripped());
+}
+
+// An E-stop whose SynRM disable is lost on the link: the load's is sent all the same, each once,
+// and the report says so per drive (what the E-stop answers); every following tick repeats the
+// lost one before reading the drives (a starved line's reads must not hold it back) until it
+// goes through and the drive reads back disabled. Nothing is reported disabled that was not.
+TEST(SafetySupervisor, AnEStopReportsEachDriveAndRepeatsALostDisableBeforeTheReads) {
+  RecordingBench r;
+  r.start(600, 1.5);
+  r.lose_synrm_disables = 4;
+  r.sup.estop(r.t, "test");
+  ASSERT_TRUE(r.sup.disable_report());
+  const DisableReport first = *r.sup.disable_report();
+  EXPECT_FALSE(first.synrm.first_acknowledged);
+  EXPECT_EQ(first.synrm.state, DisableState::repeating);
+  EXPECT_EQ(first.synrm.attempts, 1);
+  EXPECT_NE(first.synrm.error.find("disable not acknowledged"), std::string::npos) << first.synrm.error;
+  EXPECT_TRUE(first.load.first_acknowledged);
+  EXPECT_EQ(first.load.state, DisableState::acknowledged);
+  EXPECT_EQ(first.load.attempts, 1);
+  EXPECT_FALSE(first.confirmed());
+  ASSERT_GE(r.log.size(), 2u);
+  EXPECT_EQ(r.log[0].what, "synrm.enable");
+  EXPECT_EQ(r.log[1].what, "load.enable") << "the load's disable right after the SynRM's single attempt";
+  EXPECT_EQ(r.synrm_disables, 1) << "one request per drive before the caller is answered";
+  for (int tick = 0; tick < 3; ++tick) {
+    const std::size_t from = r.log.size();
+    r.run_until(r.t + 0.01);
+    ASSERT_GT(r.log.size(), from + 1);
+    EXPECT_EQ(r.log[from].what, "synrm.enable") << "tick " << tick << ": the repeat goes before the reads";
+    EXPECT_EQ(r.log[from].value, 0.0);
+    EXPECT_EQ(r.log[from + 1].what, "synrm.read");
+    EXPECT_EQ(r.sup.disable_report()->synrm.state, DisableState::repeating);
+    EXPECT_GT(r.bench.twin().snapshot().speed_rpm, 300) << "the SynRM was never disabled: it runs on";
+  }
+  r.run_until(r.t + 0.02);  // the fifth request goes through, the next read confirms it
+  const DisableReport& now = *r.sup.disable_report();
+  EXPECT_EQ(now.synrm.state, DisableState::confirmed);
+  EXPECT_EQ(now.synrm.attempts, 5);
+  EXPECT_FALSE(now.synrm.first_acknowledged) << "the first attempt's verdict is kept";
+  EXPECT_TRUE(now.synrm.error.empty()) << now.synrm.error;
+  EXPECT_EQ(now.load.state, DisableState::confirmed);
+  EXPECT_TRUE(now.confirmed());
+  EXPECT_FALSE(r.sup.confirming_stop());
+  EXPECT_FALSE(r.sup.alarm());
+  bool said_failed = false, said_confirmed = false;
+  for (const auto& [k, m] : r.events) {
+    said_failed = said_failed || (k == "fault" && m.find("disabling the SynRM drive failed") == 0);
+    said_confirmed = said_confirmed || (k == "state" && m.find("the SynRM drive reads back disabled after 5") == 0);
+  }
+  EXPECT_TRUE(said_failed);
+  EXPECT_TRUE(said_confirmed);
+  EXPECT_FALSE(r.sup.reset());
+  EXPECT_FALSE(r.sup.disable_report()) << "a reset clears it";
+}
+
+// After a stop's disable (an E-stop here, a trip's ordered stop below) the drives' setpoints are
+// written to zero: never before the disable, and a refused setpoint write neither delays nor
+// prevents it.
+TEST(SafetySupervisor, AfterTheDisableTheSetpointsGoToZero) {
+  RecordingBench r;
+  r.start(800, 1.5);
+  r.refuse_load_torque = true;
+  r.sup.estop(r.t, "test");
+  r.run_until(r.t + 0.05);
+  const auto* off_s = r.first("synrm.enable", 0.0);
+  const auto* off_l = r.first("load.enable", 0.0);
+  const auto* speed0 = r.first("synrm.speed", 0.0);
+  const auto* torque0 = r.first("load.torque", 0.0);
+  ASSERT_TRUE(off_s && off_l && speed0 && torque0);
+  EXPECT_LT(off_s, speed0) << "the disables first";
+  EXPECT_LT(off_l, speed0);
+  EXPECT_LT(off_l, torque0);
+  const DisableReport& rep = *r.sup.disable_report();
+  EXPECT_TRUE(rep.confirmed()) << "the refused torque write did not hold the disable back";
+  EXPECT_TRUE(rep.synrm.setpoint_zeroed);
+  EXPECT_FALSE(rep.load.setpoint_zeroed) << "refused: not claimed";
+  EXPECT_EQ(r.bench.twin().synrm_drive().state(), drivers::DriveState::disabled);
+  bool said = false;
+  for (const auto& [k, m] : r.events) said = said || (k == "fault" && m.find("the setpoints could not be written to zero") == 0);
+  EXPECT_TRUE(said);
+
+  // A trip's ordered stop, this time with nothing refused: both setpoints read zero after it.
+  RecordingBench t;
+  t.start(700, 2.5);
+  t.bench.twin().set_winding_temp_C(112.0);
+  for (int i = 0; i < 1500 && t.sup.phase() != SafetyPhase::stopped; ++i) t.run_until(t.t + 0.01);
+  t.run_until(t.t + 0.1);
+  ASSERT_TRUE(t.sup.disable_report());
+  EXPECT_TRUE(t.sup.disable_report()->confirmed());
+  EXPECT_TRUE(t.sup.disable_report()->synrm.setpoint_zeroed);
+  EXPECT_TRUE(t.sup.disable_report()->load.setpoint_zeroed);
+  const Recorded& last_torque = *std::find_if(t.log.rbegin(), t.log.rend(), [](const Recorded& x) { return x.what == "load.torque"; });
+  const Recorded& last_speed = *std::find_if(t.log.rbegin(), t.log.rend(), [](const Recorded& x) { return x.what == "synrm.speed"; });
+  EXPECT_EQ(last_torque.value, 0.0);
+  EXPECT_EQ(last_speed.value, 0.0);
 }
 
 // A plan tightens the bench's limits, each bound on its own; it never loosens them.

@@ -27,10 +27,13 @@ usage: estop_latency_bench.py path/to/synbench [--trials 50] [--links tcp,rtu]
   --before: also measure the status throughput of another build's daemon (its own emulator), in
   the same run: e.g. the build before the status snapshot.
   --smoke: 3 trials per link and condition, wrk 1 s with 4 connections; checks that every trial
-  ends with both drives disabled and that both servers answer (no latency target is asserted).
+  ends with both drives disabled, that every E-stop's answer says per drive what became of its
+  disable (supervisor.disable), and that both servers answer (no latency target is asserted). A
+  trial whose drives still run prints the daemon's account of its disable beside the registers.
 Exit 77 without wrk, nginx or socat; 1 when a trial or a server failed (the figures are then not
 a measurement of the daemon's E-stop). A condition gives up after 3 trials in a row fail.
 """
+import json
 import math
 import os
 import pwd
@@ -147,10 +150,19 @@ class Bench:
                 break
         pending.wait(10)
         if latency is None:
-            raise TrialError("drives not disabled %.0f s after the E-stop: %s (E-stop answered %s)"
-                             % (GIVE_UP_S, fs.describe(states), pending.status))
+            # Whose fault: the daemon's own account (its answer, then its read-back) against the
+            # registers. A disable it says was acknowledged and confirmed while the far side still
+            # reads running points at the emulator, not the bench.
+            status, body = self.serve.request("GET", "/api/bench/status")
+            now = (body.get("supervisor") or {}).get("disable") if status == 200 and isinstance(body, dict) else None
+            raise TrialError("drives not disabled %.0f s after the E-stop: %s (E-stop answered %s; its disable: %s; "
+                             "the daemon's status now: %s)" % (GIVE_UP_S, fs.describe(states), pending.status,
+                                                               describe_disable(answered_disable(pending)),
+                                                               describe_disable(now)))
         if pending.status != 200:
             raise TrialError("E-stop -> %s %s" % (pending.status, pending.body[:160] if pending.body else ""))
+        if answered_disable(pending) is None:
+            raise TrialError("the E-stop's answer has no supervisor.disable: %s" % (pending.body or b"")[:160])
         if sid is not None and not wait_for(lambda: self.sweep_state(sid) != "running", 10, 0.05):
             raise TrialError("sweep %d still running after the E-stop" % sid)
         return latency, pending.answered_at - pending.sent_at
@@ -158,6 +170,22 @@ class Bench:
     def sweep_state(self, sid):
         status, body = self.serve.request("GET", "/api/sweeps/%d" % sid)
         return body.get("state") if status == 200 and isinstance(body, dict) else None
+
+
+def answered_disable(pending):
+    """supervisor.disable of the E-stop's answer (what each drive made of its disable), or None."""
+    try:
+        return json.loads(pending.body)["supervisor"]["disable"]
+    except (TypeError, ValueError, KeyError):
+        return None
+
+
+def describe_disable(d):
+    if not d:
+        return "none"
+    return ", ".join("%s %s after %s request(s)%s" % (k, d[k]["state"], d[k]["attempts"],
+                                                     " (%s)" % d[k]["error"] if d[k].get("error") else "")
+                     for k in ("synrm", "load"))
 
 
 def start_status_poller(bench):

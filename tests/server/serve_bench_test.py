@@ -21,13 +21,17 @@ time by design). For each link:
  7. reset: 200, both drives' latched faults cleared (state disabled, fault_code none);
  8. enable again: the drives run, the shaft turns at the setpoint;
  9. SIGTERM: the daemon exits 0 and both drives read disabled, and stay so past the watchdog.
+The E-stop's answer says per drive that the disable was acknowledged (supervisor.disable), the
+status then says confirmed, and the setpoint registers read zero after it. Then `cut`: an E-stop
+while the emulator's links are cut, whose answer says "repeating" for both drives, and whose
+repeated disable stops them once the line is back.
 
 The emulator's watchdog is 3 s here (--watchdog-timeout-ms 3000: a loaded CI machine can stall
 the daemon for a fraction of a second); the E-stop deadline, 1 s, stays well inside it, and a
 drive the watchdog stopped reads faulted, not disabled: a drive reading disabled within the
 deadline was disabled by the daemon.
 
-usage: serve_bench_test.py path/to/synbench [tcp|rtu ...]
+usage: serve_bench_test.py path/to/synbench [tcp|rtu|cli|slow|cut ...]
 Exit 77 (skipped) without socat (scripts/debian-packages.txt), 1 on any failure. Standard
 library only: the Modbus master is far_side.py's, not mbpoll (a process per read is too slow to
 time an E-stop).
@@ -35,6 +39,7 @@ time an E-stop).
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -46,7 +51,7 @@ from checks import Checks  # noqa: E402
 from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
 
 BIN = sys.argv[1]
-LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow"]
+LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow", "cut"]
 WATCHDOG_MS = 3000
 ESTOP_DEADLINE_S = 1.0    # the issue's bound: request sent -> both drives read disabled
 STAY_S = 2.0              # and they stay disabled this long
@@ -213,10 +218,19 @@ def run_link(kind, tmp):
         check(len(beats) == 1,
               "%s: the heartbeat registers stop changing from %.1f s after the E-stop (before %s; after: %s)"
               % (kind, HEARTBEAT_SETTLE_S, hb_before, sorted(beats)[:6]))
+        answer = estop_disable(pending)
+        check(answer is not None and all(answer.get(d, {}).get("first_acknowledged") and
+                                         answer[d].get("state") in ("acknowledged", "confirmed") for d in ("synrm", "load")),
+              "%s: the E-stop's answer says both drives acknowledged the disable (supervisor.disable: %s)" % (kind, answer))
         status, st = serve.request("GET", "/api/bench/status")
         sup = st.get("supervisor", {}) if isinstance(st, dict) else {}
         check(sup.get("phase") == "estopped" and sup.get("tripped"),
               "%s: the daemon says estopped (%s)" % (kind, sup))
+        check((sup.get("disable") or {}).get("confirmed") is True,
+              "%s: and its status says both disables confirmed by the read-back (%s)" % (kind, sup.get("disable")))
+        zeroed = wait_for(lambda: far.speed_setpoint_rpm() == 0.0 and far.torque_setpoint_Nm() == 0.0, 2.0, 0.05)
+        check(zeroed, "%s: after the disable the setpoint registers read zero: speed %.1f rpm (SynRM holding 16-17), "
+                      "torque %.2f N m (load holding 16-17)" % (kind, far.speed_setpoint_rpm(), far.torque_setpoint_Nm()))
         ended = wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
         check(ended, "%s: the sweep stops running (%s)" % (kind, sweep_state(serve, sid)))
 
@@ -296,6 +310,76 @@ def run_link(kind, tmp):
                 note("%s: last lines of %s's log:" % (kind, name))
                 for line in tail:
                     note("  " + ("(a line with the token)" if "sbt_" in line else line))
+
+
+def estop_disable(pending):
+    """supervisor.disable of an E-stop's answer, or None."""
+    try:
+        return json.loads(pending.body)["supervisor"]["disable"]
+    except (TypeError, ValueError, KeyError):
+        return None
+
+
+def run_cut(tmp):
+    """An E-stop while the RTU line is dead (the emulator's link cut: nothing answers, on any link):
+    the answer comes at once and says, per drive, that the disable was not acknowledged and is
+    being repeated; the repeat gets through once the line is back, both drives read disabled
+    (not faulted: the watchdog is 30 s here, so only the daemon's disable can have stopped them),
+    the status says confirmed, and the setpoint registers read zero."""
+    print("--- an E-stop on a dead RTU line")
+    # Longer than the tick in flight when the E-stop comes (every request of it times out) and
+    # the E-stop's two disables.
+    cut_s = 3.0
+    pair = fs.SocatPair(tmp, "cut")
+    emu = fs.Emulator(BIN, os.path.join(tmp, "cut_emulate.log"), rtu=pair.a,
+                      args=["--watchdog-timeout-ms", "30000", "--duration-s", "900", "--fault-cut-s", str(cut_s)])
+    far = fs.ModbusTcp(emu.port, timeout=5.0)
+    serve = None
+    try:
+        cfg = fs.write_bench_config(os.path.join(tmp, "cut_bench.json"), fs.rtu_link(pair.b))
+        serve = Daemon(BIN, os.path.join(tmp, "cut_data"), ["--bench", cfg], log_path=os.path.join(tmp, "cut_serve.log"),
+                       start_timeout_s=SLOW_S)
+        status, _ = serve.request("POST", "/api/bench/setpoints", {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
+        check(status == 200, "cut: setpoints -> 200 (%s)" % status)
+        status, _ = serve.request("POST", "/api/bench/enable", {"enabled": True})
+        check(status == 200, "cut: enable -> 200 (%s)" % status)
+        spun = wait_for(lambda: running_at(far, SPEED, 0.1 * SPEED), SLOW_S, 0.1)
+        check(spun, "cut: the drives run at %.0f rpm: %s" % (SPEED, fs.describe(far.states())))
+        emu.proc.send_signal(signal.SIGUSR1)
+        line = emu.lines.get(5)
+        check(line is not None and line.startswith("link cut"), "cut: the emulator cuts its links (%s)" % line)
+        pending = PendingRequest(serve.port, serve.raw_request_bytes("POST", "/api/bench/estop"))
+        pending.wait(10)
+        reply_s = pending.answered_at - pending.sent_at if pending.answered_at else None
+        answer = estop_disable(pending)
+        check(pending.status == 200 and reply_s is not None and reply_s < cut_s,
+              "cut: the E-stop is answered 200 before the line is back (%s in %s)"
+              % (pending.status, "%.2f s" % reply_s if reply_s is not None else "-"))
+        check(answer is not None and all(answer.get(d, {}).get("state") == "repeating" and
+                                         answer[d].get("first_acknowledged") is False and answer[d].get("error")
+                                         for d in ("synrm", "load")) and answer.get("confirmed") is False,
+              "cut: its answer says neither disable was acknowledged and both are being repeated (%s)" % answer)
+        time.sleep(max(0.0, cut_s + 0.1 - (time.monotonic() - pending.sent_at)))
+        far.close()
+        far = fs.ModbusTcp(emu.port, timeout=5.0)  # the cut closed the far side's connection too
+        off = wait_for(lambda: far.states() == ((fs.DISABLED, 0), (fs.DISABLED, 0)), 2.0, 0.01)
+        t_off = time.monotonic() - pending.sent_at
+        check(off, "cut: once the line is back the repeated disable stops both drives (%.2f s after the E-stop): %s"
+              % (t_off, fs.describe(far.states())))
+        confirmed = wait_for(lambda: (serve.request("GET", "/api/bench/status")[1]["supervisor"]["disable"] or {}).get("confirmed"),
+                             2.0, 0.05)
+        d = serve.request("GET", "/api/bench/status")[1]["supervisor"]["disable"]
+        check(confirmed and d["synrm"]["attempts"] > 1 and d["load"]["attempts"] > 1 and not d["synrm"]["first_acknowledged"],
+              "cut: the status says confirmed, after %s and %s requests" % (d["synrm"]["attempts"], d["load"]["attempts"]))
+        zeroed = wait_for(lambda: far.speed_setpoint_rpm() == 0.0 and far.torque_setpoint_Nm() == 0.0, 2.0, 0.05)
+        check(zeroed, "cut: and the setpoint registers read zero: speed %.1f rpm, torque %.2f N m"
+              % (far.speed_setpoint_rpm(), far.torque_setpoint_Nm()))
+    finally:
+        if serve is not None:
+            serve.stop()
+        far.close()
+        emu.stop()
+        pair.stop()
 
 
 def run(*args, timeout=180):
@@ -406,7 +490,7 @@ def main():
     try:
         for kind in LINKS:
             try:
-                {"cli": run_cli, "slow": run_slow}.get(kind, lambda t: run_link(kind, t))(tmp)
+                {"cli": run_cli, "slow": run_slow, "cut": run_cut}.get(kind, lambda t: run_link(kind, t))(tmp)
             except (RuntimeError, OSError, fs.ModbusError) as e:
                 check(False, "%s: %s" % (kind, e))
     finally:
