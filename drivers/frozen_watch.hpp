@@ -17,18 +17,22 @@
 namespace synbench::drivers {
 
 // The least standard deviation a running drive's telemetry shows on each watched value over a
-// few seconds at steady state. From the twin (tests/emulator/telemetry_noise_test.cpp measures
-// it, read every 50 ms for 5 s, at 300 rpm unloaded, 1000 rpm 2 N m and 1500 rpm 3.5 N m; the
-// quietest point is quoted) with a margin of about 3 below it, so that a step just finer than
-// the floor still changes between reads: one step per sigma gives a run of 20 equal reads a
-// vanishing chance; a step of sigma/3 none. A real drive's sensors are noisier than the twin's
-// (physics.md: sigma_i = 15.8 mA per ADC sample before the telemetry filter), so floors from
-// the twin err on the side of watching less, never of false trips.
+// few seconds at steady state, with a margin of 3 below it, so that a step just finer than the
+// floor still changes between reads (a step of a third of sigma leaves a run of 20 equal reads
+// no chance). Measured on the twin (tests/emulator/telemetry_noise_test.cpp, read every 50 ms
+// for 5 s at 300 rpm unloaded, 1000 rpm 2 N m, 1500 rpm 3.5 N m; the quietest point quoted):
+// speed_rpm 0.052 rpm, im_A 0.54 mA, id_A 0.30 mA, iq_A 0.43 mA, ud_V 0.013 V, uq_V 0.019 V.
+// The currents agree with physics.md: sigma_i = 15.8 mA per 100 us ADC sample through the
+// firmware's 50 ms telemetry filter is 15.8 mA x sqrt(1e-4 / (2 x 0.05)) = 0.5 mA. So 1 mA
+// steps are not watched (as i16 at 0.001 A, a steady current froze 1 run in 25), 0.01 A
+// steps certainly not (6 in 6), uA steps are. A drive that filters its telemetry harder than
+// the twin is quieter: its coarse registers may still hold still, and the floors would have to
+// come from its own measurement.
 struct TelemetryNoise {
   double speed_rpm, im_A, id_A, iq_A, ud_V, uq_V;
 };
 inline constexpr TelemetryNoise kRunningNoise{
-    .speed_rpm = 0.01, .im_A = 1e-3, .id_A = 1e-3, .iq_A = 1e-3, .ud_V = 0.01, .uq_V = 0.01};
+    .speed_rpm = 0.015, .im_A = 1.5e-4, .id_A = 1e-4, .iq_A = 1.4e-4, .ud_V = 0.004, .uq_V = 0.006};
 
 // One watched value: its name and unit, where its step, floor and value live.
 struct WatchedSignal {

@@ -1,7 +1,7 @@
 // The noise of the twin's running telemetry, the measurement behind the frozen-telemetry check's
 // noise floors (drivers/frozen_watch.hpp): at steady operating points, read as the bench reads
 // (every 50 ms, a profile's poll period) for 5 s, each watched signal's standard deviation must
-// stay above its floor, else a value whose register steps are finer than the floor could still
+// stay well above its floor (the floors keep a margin of 3), else a value whose register steps are finer than the floor could still
 // sit bit for bit still while the drive runs and the check would trip on a healthy drive.
 #include <gtest/gtest.h>
 
@@ -67,7 +67,8 @@ TEST(TelemetryNoise, TwinRunsNoisierThanTheFrozenCheckFloors) {
       const auto& w = drivers::kFrozenWatched[i];
       std::printf("%4g rpm %3g N m %2g deg: %-9s sigma %.3g %s (floor %.3g)\n", op.speed_rpm, op.load_Nm,
                   op.angle_deg, w.name, sigma[i], w.unit, drivers::kRunningNoise.*w.noise);
-      EXPECT_GE(sigma[i], drivers::kRunningNoise.*w.noise)
+      // The floors sit a factor 3 below the quietest point; 2.5 of it must remain.
+      EXPECT_GE(sigma[i], 2.5 * (drivers::kRunningNoise.*w.noise))
           << w.name << " at " << op.speed_rpm << " rpm, " << op.load_Nm << " N m";
     }
   }
