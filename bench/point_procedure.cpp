@@ -287,7 +287,14 @@ void PointProcedure::tick(double now_s) {
       return;
     }
     case PointPhase::measure: {
-      if (!dev_.trigger->window_closed()) return;
+      if (!window_closed_) {
+        // The results come on the next tick: its telemetry read (above) must find both drives
+        // without a fault after the close, so a fault at the very end (a master frozen past it)
+        // fails the point instead of yielding a record; under the supervisor, its tick comes in
+        // between too.
+        window_closed_ = dev_.trigger->window_closed();
+        return;
+      }
       if (t_results_due_ < 0) t_results_due_ = now_s;
       const char* what = "";
       if (const auto ec = read_results(what)) {
@@ -326,8 +333,19 @@ std::error_code PointProcedure::read_results(const char*& what) {
   if (auto ec = dev_.load->read_window(lw)) return detail_ = dev_.load->error_detail(), ec;
   what = "reading the power meter";
   if (auto ec = dev_.meter->read(m)) return detail_ = dev_.meter->error_detail(), ec;
+  if (w.fault != drivers::Fault::none) {
+    // Latched during the window: whatever the averages say, the drive did not hold the point.
+    record_.fault = std::string(drivers::fault_name(w.fault));
+    record_.fault_code_raw = w.fault_code_raw;
+    error_ = "fault latched during the window, point not stored: " + drivers::describe_fault(w.fault, w.fault_code_raw);
+    return {};
+  }
   if (const auto why = implausible_window(w, lw, m)) {
     error_ = "implausible window result, point not stored: " + *why;
+    return {};
+  }
+  if (const auto why = window_timing_mismatch(w, lw, m, req_.window_s, opt_.host_window_jitter_s)) {
+    error_ = "window timing, point not stored: " + *why;
     return {};
   }
   auto& r = record_;
@@ -377,9 +395,9 @@ std::error_code PointProcedure::read_results(const char*& what) {
   r.fallback_fraction = w.fallback_fraction;
   r.below_min_speed = w.fallback_fraction > 0.5;
   if (w.lock_lost_fraction > 0) r.lock_lost = true;
-  if (w.fault != drivers::Fault::none) {
-    r.fault = std::string(drivers::fault_name(w.fault));
-    r.fault_code_raw = w.fault_code_raw;
+  if (const auto why = implausible_powers(r)) {
+    error_ = "implausible window result, point not stored: " + *why;
+    return {};
   }
   if (dev_.truth) r.truth = dev_.truth->read_truth_window();
   has_record_ = true;

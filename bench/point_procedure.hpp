@@ -38,6 +38,11 @@ struct PointOptions {
   // already repeated within its retry budget) skips the tick; the point fails only when no
   // telemetry, or no window result, came for this long. The safety supervisor's link deadline.
   double telemetry_timeout_s = 0.5;
+  // A window the bench keeps itself (a device without window registers) must last, by its
+  // samples, what was asked and what the meter's time base counted, within one poll period and
+  // this much: the link deadline a read may fail for before the point fails (telemetry_timeout_s),
+  // the most a sample may come late without anything being wrong.
+  double host_window_jitter_s = 0.5;
   double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
   bool ordered_stop_after = true;
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
@@ -85,7 +90,8 @@ class PointProcedure {
   void tick(double now_s);
   PointPhase phase() const { return phase_; }
   bool finished() const { return phase_ == PointPhase::done || phase_ == PointPhase::failed; }
-  // Set once the window was measured (also when the point was unstable or limited).
+  // Set once the window was measured (also when the point was unstable or limited). Never when a
+  // fault latched or a device read failed from the window's open until the record was complete.
   bool has_record() const { return has_record_; }
   const PointRecord& record() const { return record_; }
   // Why the procedure failed: which device call and what it said.
@@ -127,6 +133,9 @@ class PointProcedure {
   double t_last_tick_ = -1;
   double t_last_read_ = -1;     // telemetry last read (or the first tick)
   double t_results_due_ = -1;   // the window closed; results since then
+  // The window's close was seen; its results are read on a later tick, after a telemetry read
+  // that found no fault (a drive that faulted as the window closed fails the point).
+  bool window_closed_ = false;
   double t_step_failing_ = -1;  // a command of the current step failing on the link since
   double t_ramp_failing_ = -1;  // the load ramp's writes failing since
   std::uint64_t tolerated_reads_ = 0;

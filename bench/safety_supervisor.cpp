@@ -31,7 +31,10 @@ SafetyLimits stricter(const SafetyLimits& a, const SafetyLimits& b) {
 
 SafetySupervisor::SafetySupervisor(drivers::BenchDevices devices, SafetyLimits limits,
                                    EventSink sink)
-    : dev_(devices), lim_(limits), sink_(std::move(sink)), plausibility_(limits.plausibility) {}
+    : dev_(devices), lim_(limits), sink_(std::move(sink)), plausibility_(limits.plausibility) {
+  // The registers' steps decide which values can show a freeze (drivers/frozen_watch.hpp).
+  if (dev_.synrm) plausibility_.set_resolution(dev_.synrm->resolution());
+}
 
 void SafetySupervisor::raise(double now_s, drivers::Fault fault, std::string detail,
                              std::optional<std::int64_t> fault_code_raw) {

@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "bench/disable_report.hpp"
 #include "bench/ordered_stop.hpp"
@@ -96,6 +97,9 @@ class SafetySupervisor {
   // Which drives the last read found running or could not read, in words ("the SynRM drive
   // still reports running"); empty when both read back off.
   std::string unconfirmed() const;
+  // The SynRM drive's values the frozen-telemetry check cannot watch (their registers' steps are
+  // coarser than a running drive's noise), for the record of what was supervised.
+  std::vector<drivers::FrozenBlindSpot> frozen_blind_spots() const { return plausibility_.blind_spots(); }
   // Time from detection to both drives disabled, once the stop has completed.
   std::optional<double> stop_duration_s() const { return stop_duration_s_; }
 

@@ -22,17 +22,35 @@ std::uint64_t bits_of(double v) {
 
 }  // namespace
 
+TelemetryPlausibility::TelemetryPlausibility(PlausibilityLimits limits) : lim_(limits) {
+  set_resolution({});
+}
+
+void TelemetryPlausibility::set_resolution(const drivers::TelemetryResolution& r) {
+  resolution_ = r;
+  for (std::size_t i = 0; i < kWatched; ++i) {
+    const auto& w = drivers::kFrozenWatched[i];
+    watchable_[i] = drivers::frozen_watchable(r.*w.step, lim_.noise_floor.*w.noise);
+  }
+  frozen_ = {};
+}
+
+std::vector<drivers::FrozenBlindSpot> TelemetryPlausibility::blind_spots() const {
+  return drivers::frozen_blind_spots(resolution_, lim_.noise_floor);
+}
+
 void TelemetryPlausibility::reset() {
   frozen_ = {};
   at_rest_since_s_ = -1;
 }
 
-std::optional<Implausibility> TelemetryPlausibility::frozen(double now_s, std::size_t i, const char* name,
-                                                            const char* unit, double value, bool watched) {
+std::optional<Implausibility> TelemetryPlausibility::frozen(double now_s, std::size_t i, double value,
+                                                            bool watched) {
   Frozen& f = frozen_[i];
+  const auto& w = drivers::kFrozenWatched[i];
   // Exactly 0 is a value a drive really holds (no encoder edges at standstill), not a sign of a
   // hung task; and only a running drive must show its noise.
-  if (!watched || value == 0.0 || !std::isfinite(value)) {
+  if (!watched || !watchable_[i] || value == 0.0 || !std::isfinite(value)) {
     f.valid = false;
     return std::nullopt;
   }
@@ -46,8 +64,8 @@ std::optional<Implausibility> TelemetryPlausibility::frozen(double now_s, std::s
   if (f.reads < lim_.frozen_reads || span_s < lim_.frozen_s) return std::nullopt;
   char buf[160];
   std::snprintf(buf, sizeof buf, "frozen at %.6g %s, bit for bit, for %d reads (%.2f s) while the drive runs",
-                value, unit, f.reads, span_s);
-  return Implausibility{name, buf};
+                value, w.unit, f.reads, span_s);
+  return Implausibility{w.name, buf};
 }
 
 std::optional<Implausibility> TelemetryPlausibility::check(double now_s, const drivers::SynrmTelemetry& t) {
@@ -68,19 +86,11 @@ std::optional<Implausibility> TelemetryPlausibility::check(double now_s, const d
 
   const bool run = drivers::running(t.state);
   // On the voltage limit the controller clamps its references: leave them out then.
-  const struct {
-    const char* name;
-    const char* unit;
-    double value;
-    bool watched;
-  } watched[kWatched] = {
-      {"speed_rpm", "rpm", t.speed_rpm, run}, {"im_A", "A", t.im_A, run},
-      {"id_A", "A", t.id_A, run},             {"iq_A", "A", t.iq_A, run},
-      {"ud_V", "V", t.ud_V, run && !t.voltage_limited}, {"uq_V", "V", t.uq_V, run && !t.voltage_limited},
-  };
   std::optional<Implausibility> found;
   for (std::size_t i = 0; i < kWatched; ++i) {
-    auto f = frozen(now_s, i, watched[i].name, watched[i].unit, watched[i].value, watched[i].watched);
+    const auto& w = drivers::kFrozenWatched[i];
+    const bool voltage = w.value == &drivers::SynrmTelemetry::ud_V || w.value == &drivers::SynrmTelemetry::uq_V;
+    auto f = frozen(now_s, i, t.*w.value, run && !(voltage && t.voltage_limited));
     if (f && !found) found = std::move(f);
   }
   if (found) return found;

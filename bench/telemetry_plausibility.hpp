@@ -10,21 +10,28 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "drivers/devices.hpp"
+#include "drivers/frozen_watch.hpp"
 
 namespace synbench::bench {
 
 // Thresholds and why (docs/record.md, "What the supervisor checks").
 struct PlausibilityLimits {
   // Frozen: an analogue value of a running drive carries ADC noise and PWM ripple in its last
-  // bits, so the same f32 bits read after read mean the value is no longer being updated. Both
+  // bits, so the same bits read after read (of a register fine enough to show that noise) mean
+  // the value is no longer being updated. Both
   // a count of consecutive identical reads and a span of bench time must be exceeded, so a bench
   // that polls faster than the drive refreshes (or a twin that lags its clock for a moment) is
   // not taken for a stuck sensor. 1 s: the firmware refreshes telemetry every control period
   // (100 us); nothing physical holds an f32 current or speed for a second.
   int frozen_reads = 20;
   double frozen_s = 1.0;
+  // A value is watched only when its register's step (the drive's TelemetryResolution) is finer
+  // than the noise a running drive shows on it (drivers/frozen_watch.hpp): an i16 current in
+  // 0.01 A steps holds still for seconds at a steady point without anything being stuck.
+  drivers::TelemetryNoise noise_floor = drivers::kRunningNoise;
   // Values exactly 0 are left out of the frozen check: a drive at standstill reports a speed of
   // exactly 0 (no encoder edges), a drive on its voltage limit clamps nothing to 0.
   // Current with the shaft at rest: more than `rest_current_A` for `rest_s` with the speed
@@ -54,28 +61,34 @@ struct Implausibility {
 
 class TelemetryPlausibility {
  public:
-  explicit TelemetryPlausibility(PlausibilityLimits limits = {}) : lim_(limits) {}
+  explicit TelemetryPlausibility(PlausibilityLimits limits = {});
 
   // One telemetry read at `now_s`: the first implausibility found, if any.
   std::optional<Implausibility> check(double now_s, const drivers::SynrmTelemetry& t);
   // Forgets the history (after a reset of the bench).
   void reset();
+  // The steps of the drive's registers (SynrmDrive::resolution()); values whose steps are not
+  // finer than their noise floor are no longer watched for freezing. Default: continuous.
+  void set_resolution(const drivers::TelemetryResolution& r);
+  // What the frozen check leaves alone with the resolution set.
+  std::vector<drivers::FrozenBlindSpot> blind_spots() const;
 
   const PlausibilityLimits& limits() const { return lim_; }
 
  private:
-  // The f32 signals watched for freezing.
-  static constexpr std::size_t kWatched = 6;
+  // The signals watched for freezing.
+  static constexpr std::size_t kWatched = drivers::kFrozenWatched.size();
   struct Frozen {
     std::uint64_t bits = 0;
     int reads = 0;        // consecutive reads with these bits
     double since_s = 0;   // first of them
     bool valid = false;
   };
-  std::optional<Implausibility> frozen(double now_s, std::size_t i, const char* name, const char* unit,
-                                       double value, bool watched);
+  std::optional<Implausibility> frozen(double now_s, std::size_t i, double value, bool watched);
 
   PlausibilityLimits lim_;
+  drivers::TelemetryResolution resolution_;
+  std::array<bool, kWatched> watchable_{};
   std::array<Frozen, kWatched> frozen_{};
   double at_rest_since_s_ = -1;
 };

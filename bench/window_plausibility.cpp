@@ -77,4 +77,59 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
   return std::nullopt;
 }
 
+std::optional<std::string> window_timing_mismatch(const drivers::SynrmWindow& w, const drivers::LoadWindow& load,
+                                                  const drivers::MeterReading& meter, double requested_s,
+                                                  double jitter_s) {
+  using drivers::WindowKeeper;
+  const struct {
+    const char* who;
+    bool host;
+    double span_s;
+    const drivers::HostSampling& sampling;
+  } sources[] = {
+      {"the SynRM drive's host samples", w.keeper == WindowKeeper::host, w.window_s, w.host},
+      {"the load drive's host samples", load.keeper == WindowKeeper::host, load.window_s, load.host},
+      {"the power meter's host samples", meter.keeper == WindowKeeper::host, meter.gate_s, meter.host},
+  };
+  // The meter's own time base, where it keeps one (a gate or a totalizer's time-base counter).
+  const bool meter_clock = meter.keeper == WindowKeeper::device && meter.gate_s > 0;
+  char buf[320];
+  for (const auto& s : sources) {
+    if (!s.host) continue;
+    const double tolerance_s = s.sampling.poll_period_s + jitter_s;
+    if (meter_clock && std::fabs(s.span_s - meter.gate_s) > tolerance_s) {
+      std::snprintf(buf, sizeof buf,
+                    "window: %.4g s by %s but %.4g s by the meter's time base (tolerance %.3g s: one poll period and "
+                    "%.3g s of jitter): the powers would come from different spans",
+                    s.span_s, s.who, meter.gate_s, tolerance_s, jitter_s);
+      return std::string(buf);
+    }
+    if (std::fabs(s.span_s - requested_s) > tolerance_s) {
+      std::snprintf(buf, sizeof buf,
+                    "window: %.4g s by %s but %.4g s asked (tolerance %.3g s; longest gap between samples %.3g s): "
+                    "the bench did not poll the window to its end on time",
+                    s.span_s, s.who, requested_s, tolerance_s, s.sampling.longest_gap_s);
+      return std::string(buf);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> implausible_powers(const PointRecord& r) {
+  char buf[240];
+  if (r.pm_W > 0 && r.pdcm_W <= 0) {
+    std::snprintf(buf, sizeof buf, "pm_W: %.4g W of mechanical output with pdcm_W %.4g W of electrical input", r.pm_W,
+                  r.pdcm_W);
+    return std::string(buf);
+  }
+  if (r.pm_W > 0 && r.pm_W > r.pdcm_W) {
+    std::snprintf(buf, sizeof buf,
+                  "efficiency: %.4g > 1: pm_W %.4g W exceeds pdcm_W %.4g W while motoring (a motor puts out less "
+                  "than it takes in)",
+                  r.pm_W / r.pdcm_W, r.pm_W, r.pdcm_W);
+    return std::string(buf);
+  }
+  return std::nullopt;
+}
+
 }  // namespace synbench::bench

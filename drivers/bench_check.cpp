@@ -29,6 +29,10 @@ std::optional<std::string> register_collision(const DeviceProfile& a, const Devi
   return std::nullopt;
 }
 
+std::vector<FrozenBlindSpot> frozen_check_blind_spots(const BenchProfiles& profiles) {
+  return frozen_blind_spots(telemetry_resolution(profiles.synrm_drive));
+}
+
 std::vector<ProfileError> check_bench(const BenchConfig& config, const BenchProfiles& profiles, bool one_endpoint) {
   std::vector<ProfileError> errors;
   for (std::size_t i = 0; i < kDeviceKinds.size(); ++i) {

@@ -60,6 +60,14 @@ enum class WindowKeeper { device, host };
 
 constexpr const char* keeper_name(WindowKeeper k) { return k == WindowKeeper::host ? "host" : "device"; }
 
+// How the bench sampled a window it kept (keeper host): the poll period asked for and the
+// longest time between two samples taken, so the point can refuse a window the bench stopped
+// polling in (bench/window_plausibility.hpp).
+struct HostSampling {
+  double poll_period_s = 0;
+  double longest_gap_s = 0;
+};
+
 // Results of one measurement window, accumulated by the drive at its control rate (or by the
 // bench from polled telemetry: keeper host).
 struct SynrmWindow {
@@ -83,6 +91,16 @@ struct SynrmWindow {
   Fault fault = Fault::none;  // fault latched during the window, if any
   WindowKeeper keeper = WindowKeeper::device;
   std::optional<std::int64_t> fault_code_raw;  // the device's code of an unknown fault
+  HostSampling host;  // keeper host only
+};
+
+// The step of each telemetry value the frozen-telemetry check watches, as the drive's registers
+// carry it: an integer register's value moves only in whole steps of its scale, so a steady
+// value of a coarse register reads bit for bit the same without anything being stuck; 0 for a
+// float register or an in-process value (continuous). drivers/frozen_watch.hpp says which steps
+// are too coarse to watch.
+struct TelemetryResolution {
+  double speed_rpm = 0, im_A = 0, id_A = 0, iq_A = 0, ud_V = 0, uq_V = 0;
 };
 
 class SynrmDrive {
@@ -103,6 +121,8 @@ class SynrmDrive {
   // What the last failed call ran into in the device's terms (signal, register, raw words),
   // for the message that reports it; empty when there is nothing to add.
   virtual std::string error_detail() const { return {}; }
+  // The steps of the telemetry read() returns; the default: continuous (a twin, a float map).
+  virtual TelemetryResolution resolution() const { return {}; }
 };
 
 struct LoadTelemetry {
@@ -117,6 +137,8 @@ struct LoadWindow {
   std::uint32_t samples = 0;
   double torque_Nm = 0;
   WindowKeeper keeper = WindowKeeper::device;
+  double window_s = 0;  // keeper host: from the first sample to the last; else 0 (not reported)
+  HostSampling host;    // keeper host only
 };
 
 class LoadDrive {
@@ -145,6 +167,7 @@ struct MeterReading {
   std::optional<double> pdcm_W, pdcg_W;
   WindowKeeper keeper = WindowKeeper::device;
   std::uint32_t samples = 0;  // host-kept: the polls averaged
+  HostSampling host;          // keeper host only
 };
 
 class PowerMeter {

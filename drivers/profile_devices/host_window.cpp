@@ -26,6 +26,7 @@ std::error_code HostWindow::open(double now_s, double window_s) {
   end_s_ = now_s + window_s;
   next_s_ = now_s;
   samples_ = 0;
+  longest_gap_s_ = 0;
   std::fill(stats_.begin(), stats_.end(), Stats{});
   return {};
 }
@@ -38,9 +39,13 @@ std::error_code HostWindow::sample(double now_s) {
     s.sum += v;
     s.min = samples_ == 0 ? v : std::min(s.min, v);
     s.max = samples_ == 0 ? v : std::max(s.max, v);
-    if (s.first_nonzero == 0 && v != 0 && v == v) s.first_nonzero = v;
+    if (s.first_nonzero == 0 && v != 0 && v == v) {
+      s.first_nonzero = v;
+      s.first_nonzero_device = plan_.device_value(i);
+    }
   }
   if (samples_ == 0) first_s_ = now_s;
+  if (samples_ > 0) longest_gap_s_ = std::max(longest_gap_s_, now_s - last_s_);
   last_s_ = now_s;
   ++samples_;
   // The next point of the grid after now: a late sample does not shift the grid, a missed

@@ -39,14 +39,19 @@ class HostWindow final : public WindowSource {
   double mean(std::size_t i) const { return samples_ > 0 ? stats_[i].sum / samples_ : nan(); }
   double min(std::size_t i) const { return stats_[i].min; }
   double max(std::size_t i) const { return stats_[i].max; }
-  // The first sample's non-zero value (a fault code latched during the window), else 0.
+  // The first sample's non-zero value (a fault code latched during the window), else 0, and
+  // the device's own number behind it (ReadPlan::device_value: the raw code of an unknown fault).
   double first_nonzero(std::size_t i) const { return stats_[i].first_nonzero; }
+  double first_nonzero_device(std::size_t i) const { return stats_[i].first_nonzero_device; }
   double period_s() const { return period_s_; }
+  // The longest time between two samples (0 with fewer than two): a bench that stopped polling
+  // (a frozen or starved master) leaves a gap no average over the window can see.
+  double longest_gap_s() const { return longest_gap_s_; }
 
  private:
   enum class State { never, open, done, expired };
   struct Stats {
-    double sum = 0, min = 0, max = 0, first_nonzero = 0;
+    double sum = 0, min = 0, max = 0, first_nonzero = 0, first_nonzero_device = nan();
   };
   static double nan() { return std::numeric_limits<double>::quiet_NaN(); }
   std::error_code sample(double now_s);
@@ -55,7 +60,7 @@ class HostWindow final : public WindowSource {
   const ReadPlan& plan_;
   double period_s_;
   State state_ = State::never;
-  double end_s_ = 0, next_s_ = 0, first_s_ = 0, last_s_ = 0;
+  double end_s_ = 0, next_s_ = 0, first_s_ = 0, last_s_ = 0, longest_gap_s_ = 0;
   std::uint32_t samples_ = 0;
   std::vector<Stats> stats_;
   std::vector<double> values_;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "drivers/error.hpp"
+#include "drivers/frozen_watch.hpp"
 
 namespace synbench::drivers {
 namespace {
@@ -116,6 +117,8 @@ std::error_code ProfileSynrmDrive::set_estimator(Estimator estimator) {
   return ec;
 }
 
+TelemetryResolution ProfileSynrmDrive::resolution() const { return telemetry_resolution(profile()); }
+
 std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   double v[14];
   if (auto ec = io().read(telemetry_, v)) return ec;
@@ -190,6 +193,8 @@ std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
   w.samples = h.samples();
   w.window_s = h.span_s();
   w.fault = static_cast<Fault>(static_cast<int>(h.first_nonzero(1)));
+  w.fault_code_raw = raw_code(w.fault, h.first_nonzero_device(1));
+  w.host = {h.period_s(), h.longest_gap_s()};
   w.speed_meas_rpm = h.mean(2);
   w.im_A = or_(h.mean(3));
   w.id_A = or_(h.mean(4));
@@ -240,6 +245,8 @@ std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
     w.keeper = WindowKeeper::host;
     w.samples = host_->samples();
     w.torque_Nm = host_->mean(2);
+    w.window_s = host_->span_s();
+    w.host = {host_->period_s(), host_->longest_gap_s()};
     out = w;
     return {};
   }
@@ -278,6 +285,7 @@ std::error_code ProfileMeter::read(MeterReading& out) {
     m.gate_s = host_->span_s();
     m.pdcm_W = host_->mean(0);
     m.pdcg_W = host_->mean(1);
+    m.host = {host_->period_s(), host_->longest_gap_s()};
     out = m;
     return {};
   }

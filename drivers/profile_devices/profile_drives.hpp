@@ -78,6 +78,8 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   std::error_code read(SynrmTelemetry& out) override;
   std::error_code read_window(SynrmWindow& out) override;
   std::string error_detail() const override { return device_error(); }
+  // From the profile's types and scales (drivers/frozen_watch.hpp).
+  TelemetryResolution resolution() const override;
 
  private:
   std::error_code read_host_window(SynrmWindow& out);

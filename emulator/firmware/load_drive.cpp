@@ -80,8 +80,11 @@ double LoadDriveFirmware::control(double iq_measured_A) {
   f_iq_.update(iq_measured_A);
   if (window_left_ > 0) {
     w_iq_.add(iq_measured_A);
-    if (--window_left_ == 0)
-      window_result_ = {static_cast<std::uint32_t>(w_iq_.count()), kt_ * w_iq_.mean()};
+    if (--window_left_ == 0) {
+      window_result_ = {};
+      window_result_.samples = static_cast<std::uint32_t>(w_iq_.count());
+      window_result_.torque_Nm = kt_ * w_iq_.mean();
+    }
   }
   return torque_cmd_Nm_ / kt_;
 }

@@ -1,6 +1,7 @@
 // `synbench bench check CONFIG [--probe]`: a bench config and the profiles it names validated
 // together (every problem with its file and JSON pointer, plus the cross-checks of
-// drivers/bench_check.hpp), and with --probe every readable signal of every device read once
+// drivers/bench_check.hpp) and the telemetry values the supervisor's frozen check cannot watch,
+// and with --probe every readable signal of every device read once
 // over the config's own links (the buses `point --bench` uses), printed as a table.
 #include <algorithm>
 #include <array>
@@ -127,6 +128,16 @@ int bench_check_command(const std::vector<std::string>& argv) {
     if (!json)
       std::cout << "  " << drivers::name(k) << ": " << p.name << " (" << d.profile.string() << "), link " << d.link
                 << ", " << p.signals.size() << " signals, unit ids " << unit_ids(p) << "\n";
+  }
+  // Not a problem, but what the supervisor will not see: said before anyone relies on it.
+  const auto blind = drivers::frozen_check_blind_spots(*profiles);
+  out["frozen_check_unwatched"] = nlohmann::json::array();
+  for (const auto& b : blind)
+    out["frozen_check_unwatched"].push_back(
+        {{"signal", b.signal}, {"step", b.step}, {"noise", b.noise}, {"unit", b.unit}, {"reason", b.describe()}});
+  if (!json && !blind.empty()) {
+    std::cout << "  the frozen-telemetry check cannot watch:\n";
+    for (const auto& b : blind) std::cout << "    " << b.describe() << "\n";
   }
   int status = 0;
   if (probe) {

@@ -26,7 +26,10 @@ A bench config (docs/bench-config.md) and its devices from the command line, wit
            "FILE: /json/pointer: reason" (a profile's own problems name the profile file after
            the device's pointer), and what shows only when they are put together (two devices
            on one link with the same unit id and overlapping registers, one serial port named by
-           two links). With --probe, connects over the config's links and reads every readable
+           two links). It also lists the SynRM drive's telemetry values whose register
+           steps are coarser than a running drive's noise, which the supervisor's
+           frozen-telemetry check therefore cannot watch (--json: "frozen_check_unwatched").
+           With --probe, connects over the config's links and reads every readable
            signal of every device once (reads only, never a write), printing device, signal,
            table, address(es), unit id, raw registers (hex) and the decoded value and unit, or
            the signal's error. Exit 0 when valid (and, probing, every signal read), 1 otherwise

@@ -178,5 +178,48 @@ TEST(TelemetryPlausibility, ResetForgetsTheHistory) {
   EXPECT_TRUE(p.check(1.95, t));
 }
 
+// A coarse integer register (i16 at 0.01 A) holds a steady current bit for bit: not a finding,
+// whatever the time. The resolution comes from the drive (SynrmDrive::resolution()).
+TEST(TelemetryPlausibility, ACoarseSteadyIntegerSignalIsNotAFinding) {
+  TelemetryPlausibility p;
+  drivers::TelemetryResolution r;
+  r.id_A = 0.01;
+  r.iq_A = 0.01;
+  p.set_resolution(r);
+  for (int i = 0; i < 600; ++i) {
+    SynrmTelemetry t = running_at(i);
+    t.id_A = 0.91;  // "id_A frozen at 0.91 A, bit for bit, for 66 reads": a steady current
+    t.iq_A = 1.70;
+    ASSERT_FALSE(p.check(0.05 * i, t)) << i;
+  }
+  const auto blind = p.blind_spots();
+  ASSERT_EQ(blind.size(), 2u);
+  EXPECT_EQ(blind[0].signal, "id_A");
+  EXPECT_EQ(blind[1].signal, "iq_A");
+  EXPECT_NE(blind[0].describe().find("id_A: 0.01 A steps, coarser than its noise"), std::string::npos)
+      << blind[0].describe();
+}
+
+// The same frozen value in a float register, or in an integer register finer than the noise,
+// still trips: only what cannot show noise is left alone.
+TEST(TelemetryPlausibility, AFrozenFloatOrFineIntegerSignalStillTrips) {
+  for (const double step : {0.0, 1e-6}) {
+    TelemetryPlausibility p;
+    drivers::TelemetryResolution r;
+    r.id_A = step;
+    r.iq_A = 0.01;  // another signal coarse: it does not blind the check to id_A
+    p.set_resolution(r);
+    std::optional<Implausibility> found;
+    for (int i = 0; i < 100 && !found; ++i) {
+      SynrmTelemetry t = running_at(i);
+      t.id_A = 0.91;
+      found = p.check(0.05 * i, t);
+    }
+    ASSERT_TRUE(found) << "step " << step;
+    EXPECT_EQ(found->signal, "id_A");
+    EXPECT_TRUE(p.blind_spots().size() == 1 && p.blind_spots()[0].signal == "iq_A");
+  }
+}
+
 }  // namespace
 }  // namespace synbench::bench

@@ -113,6 +113,65 @@ PointRequest request_700() {
   return r;
 }
 
+// A host-kept SynRM window (50 ms polls) over a totalizer meter's 20 s: as measured, and with
+// the master frozen past the window's end (the last sample 28.6 s after the first, the meter's
+// time base counting on), and with the meter's close latched late while the samples stopped.
+TEST(WindowTiming, AHostWindowMustLastWhatTheMeterAndTheRequestSay) {
+  Window x;
+  x.w.keeper = drivers::WindowKeeper::host;
+  x.w.window_s = 20.0;
+  x.w.host = {0.05, 0.07};
+  x.m.gate_s = 20.01;
+  EXPECT_FALSE(window_timing_mismatch(x.w, x.l, x.m, 20.0, 0.5));
+  Window frozen = x;
+  frozen.w.window_s = 28.6;
+  frozen.w.host.longest_gap_s = 20.3;
+  frozen.m.gate_s = 28.6;
+  const auto why = window_timing_mismatch(frozen.w, frozen.l, frozen.m, 20.0, 0.5);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("28.6 s by the SynRM drive's host samples but 20 s asked"), std::string::npos) << *why;
+  Window split = x;
+  split.m.gate_s = 28.6;
+  const auto why2 = window_timing_mismatch(split.w, split.l, split.m, 20.0, 0.5);
+  ASSERT_TRUE(why2);
+  EXPECT_NE(why2->find("20 s by the SynRM drive's host samples but 28.6 s by the meter's time base"),
+            std::string::npos)
+      << *why2;
+  // Within a poll period and the jitter: late by 0.5 s, fine.
+  Window late = x;
+  late.w.window_s = late.m.gate_s = 20.5;
+  EXPECT_FALSE(window_timing_mismatch(late.w, late.l, late.m, 20.0, 0.5));
+  // A load drive's host window is held to the same.
+  Window load = x;
+  load.l.keeper = drivers::WindowKeeper::host;
+  load.l.window_s = 12.0;
+  load.l.host = {0.05, 8.0};
+  const auto why3 = window_timing_mismatch(load.w, load.l, load.m, 20.0, 0.5);
+  ASSERT_TRUE(why3);
+  EXPECT_NE(why3->find("the load drive's host samples"), std::string::npos) << *why3;
+  // Device-kept windows are the devices' own business.
+  Window device;
+  device.m.gate_s = 3.0;
+  EXPECT_FALSE(window_timing_mismatch(device.w, device.l, device.m, 1.0, 0.5));
+}
+
+TEST(RecordPowers, AnEfficiencyAboveOneIsRefusedNamingTheFields) {
+  PointRecord r;
+  r.pdcm_W = 542;
+  r.pm_W = 480;
+  EXPECT_FALSE(implausible_powers(r));
+  r.pm_W = 811.4;  // the 1.497 seen with a frozen master
+  const auto why = implausible_powers(r);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("efficiency: 1.497 > 1: pm_W 811.4 W exceeds pdcm_W 542 W"), std::string::npos) << *why;
+  r.pdcm_W = -3;
+  const auto why2 = implausible_powers(r);
+  ASSERT_TRUE(why2);
+  EXPECT_NE(why2->find("pm_W: 811.4 W of mechanical output with pdcm_W -3 W"), std::string::npos) << *why2;
+  PointRecord idle;  // nothing in, nothing out: a shaft at rest is no finding
+  EXPECT_FALSE(implausible_powers(idle));
+}
+
 TEST(WindowPlausibility, APointWhoseWindowReadsMinus99AIsRefusedNotRecorded) {
   emulator::TwinBench bench{emulator::TwinConfig{}};
   SpoiledDrive drive(*bench.devices().synrm);

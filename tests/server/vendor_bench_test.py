@@ -3,7 +3,7 @@
 (`synbench emulate --bench`) and driven by synbench's real Modbus code, checked from the far side.
 The profiles in vendor_bench/: a SynRM drive with a control word (enable bit 0, fault reset bit 7
 pulsed), a status word (state from a mask, several codes per label, `otherwise`), CiA-402-like
-fault codes without the watchdog's, word-swapped f32 and i32 telemetry, an any_write watchdog and
+fault codes without the watchdog's, word-swapped f32 telemetry and i16 currents in 0.01 A, an any_write watchdog and
 no window signals; a load drive with enable/reset coils, an i16 torque setpoint in 0.1 % of 10 N m
 and an any_write watchdog; a totalizer meter (u32 counters, 1 MHz time base).
 Checked: a whole point over TCP and over RTU (socat pty pair) against the same point on the
@@ -88,6 +88,9 @@ check(code == 0 and out.count(": ok: ") == 3, f"profile check of the vendor prof
 for fixture in ("bench_tcp.json", "bench_rtu.json"):
     code, out, err = run("bench", "check", os.path.join(FIXTURES, fixture))
     check(code == 0 and " ok\n" in out, f"bench check of {fixture}: {out.strip()[:200]} {err.strip()}")
+    # i16 currents at 0.01 A are coarser than a running drive's noise: said, not silently dropped.
+    check(all(f"{s}: 0.01 A steps, coarser than its noise" in out for s in ("im_A", "id_A", "iq_A")),
+          f"bench check of {fixture} names the currents the frozen check cannot watch: {out.strip()[-400:]}")
 
 # --- the reference: the same point on the default map, in-process, over 8 noise seeds -----------
 reference = []

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "drivers/error.hpp"
 #include "drivers/profile_devices/profile_bench.hpp"
@@ -209,6 +212,48 @@ TEST(ProfileBenchHostWindows, TheClockSamplesWhileTheBenchWaits) {
   EXPECT_NEAR(m.gate_s, 0.5, 1e-5);
   EXPECT_NEAR(m.idcm_A, 2.0, 1e-3);
   EXPECT_NEAR(m.idcg_A, -0.5, 1e-3);
+}
+
+// The master frozen past the window's end (SIGSTOP): nothing polled for 20 s while the drive's
+// watchdog tripped with a code the profile has no label for. The host window closes on the first
+// poll after, with that sample: its fault is `unknown` carrying the device's code, and its
+// longest gap and span show the bench stopped polling (the point refuses it:
+// bench/window_plausibility.hpp), while the totalizer counted the whole 20.3 s.
+TEST(ProfileBenchHostWindows, AMasterFrozenPastTheEndLeavesAGapAndTheDevicesCode) {
+  FakeBus bus;
+  ManualClock clock;
+  std::ifstream in(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / "synrm_host_window.json");
+  nlohmann::json doc = nlohmann::json::parse(in);
+  doc["signals"]["fault_code"]["values"].erase("watchdog");
+  ProfileParseResult synrm = parse_device_profile(doc);
+  ASSERT_TRUE(synrm.profile);
+  ProfileBench bench{bus, *synrm.profile, bus, test_profile("load_host_window.json"),
+                     bus, test_profile("meter_totalizer.json"), clock};
+  const DeviceProfile& sp = bench.synrm().profile();
+  const DeviceProfile& mp = bench.meter().profile();
+  bus.set(*sp.find("udc_V"), 425);
+  bus.before = [&](const FakeBus::Request&) {
+    const auto counter = [&](double hz) { return static_cast<double>(std::llround(hz * clock.t) % k2to32); };
+    bus.set(*mp.find("total_m"), counter(700e3));
+    bus.set(*mp.find("total_g"), counter(450e3));
+    bus.set(*mp.find("time_base_ticks"), counter(1e6));
+  };
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  while (clock.t < 0.3 - 1e-9) bench.clock().wait_until(clock.t + 0.01);
+  clock.t = 20.3;  // frozen: no tick, no sample, no heartbeat
+  bus.set(*sp.find("fault_code"), 6);
+  while (!bench.trigger().window_closed()) bench.clock().wait_until(clock.t + 0.01);
+  SynrmWindow w;
+  MeterReading m;
+  ASSERT_FALSE(bench.synrm().read_window(w));
+  ASSERT_FALSE(bench.meter().read(m));
+  EXPECT_EQ(w.fault, Fault::unknown);
+  ASSERT_TRUE(w.fault_code_raw);
+  EXPECT_EQ(*w.fault_code_raw, 6);
+  EXPECT_DOUBLE_EQ(w.host.poll_period_s, 0.05);
+  EXPECT_NEAR(w.host.longest_gap_s, 20.0, 0.01);
+  EXPECT_NEAR(w.window_s, 20.3, 1e-6);
+  EXPECT_NEAR(m.gate_s, 20.3, 1e-5);
 }
 
 }  // namespace
