@@ -2,7 +2,7 @@
 """`synbench serve`'s WebSocket /ws and the dashboard's static files, over real sockets on
 loopback: the Host and Origin checks on the upgrade, auth (1008 on a bad, missing or late
 token), roles through `request` (viewer 403, operator E-stop stops the bench), telemetry pacing
-(20, 50 and the default 10 Hz: the median gap of the messages' bench times within 15 %), the protocol's errors (bad_message naming the field, connection kept),
+(20, 50 and the default 10 Hz: the messages' mean spacing in bench time), the protocol's errors (bad_message naming the field, connection kept),
 oversized messages (1009), events and state pushes; static files: index, content types, caching,
 HEAD, ETag, traversal attempts and symlinks out (never a file outside the directory), and the
 "not built" page.
@@ -59,16 +59,16 @@ def count_telemetry(ws, seconds):
 
 def check_paced(times, rate, seconds, what):
     """The daemon paces a subscription at its rate. Asserted on the bench times the messages carry
-    (the median gap), which a loaded test machine cannot skew, and as a bound: never more messages
-    than the rate allows. The delivered wall-clock rate is a figure of tests/perf/ws_fanout_bench.py,
-    not a functional check."""
-    gaps = sorted(b - a for a, b in zip(times, times[1:]))
-    check(len(gaps) >= rate * seconds / 4, "%s: telemetry flows (%d messages in %.0f s)" % (what, len(times), seconds))
-    if not gaps:
+    (their mean spacing, so a message the test's process was late to read does not count against
+    the daemon; the hub sends on its own 20 ms tick, so single gaps alternate around 1/rate), and
+    as a bound: never more messages than the rate allows. The delivered wall-clock rate is a
+    figure of tests/perf/ws_fanout_bench.py, not a functional check."""
+    check(len(times) >= rate * seconds / 4, "%s: telemetry flows (%d messages in %.0f s)" % (what, len(times), seconds))
+    if len(times) < 2:
         return
-    median = gaps[len(gaps) // 2]
-    check(abs(median * rate - 1) <= 0.15, "%s: median gap %.1f ms of bench time (1/rate %.1f ms)"
-          % (what, median * 1e3, 1e3 / rate))
+    mean = (times[-1] - times[0]) / (len(times) - 1)
+    check(0.85 <= mean * rate <= 1.25, "%s: mean spacing %.1f ms of bench time (1/rate %.1f ms)"
+          % (what, mean * 1e3, 1e3 / rate))
     check(len(times) <= 1.15 * rate * seconds + 2, "%s: never faster than subscribed (%d messages in %.0f s)"
           % (what, len(times), seconds))
 
