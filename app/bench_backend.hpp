@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "app/bench_description.hpp"
 #include "drivers/clock.hpp"
@@ -31,7 +31,7 @@ class BenchBackend {
   virtual void set_heartbeats(bool on) { heartbeats_ = on; }
   virtual bool heartbeats() const { return heartbeats_; }
   // The devices as GET /api/devices shows them: [{"role", "kind", "backend", "link", "profile"}].
-  virtual nlohmann::json describe() const = 0;
+  virtual synbench::Json describe() const = 0;
   virtual const BenchDescription& description() const = 0;
   // The links in words, for messages: "tcp 127.0.0.1:1502", "twin (in-process)".
   virtual std::string links() const { return "twin (in-process)"; }

@@ -10,6 +10,8 @@
 // stopped, latching an alarm if one still runs. Free of HTTP and of the twin.
 #pragma once
 
+#include "drivers/json.hpp"
+
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -72,7 +74,7 @@ class BenchRuntime {
   // The latest snapshot; never waits on the bench thread's device I/O.
   std::shared_ptr<const StatusSnapshot> snapshot() const;
   const BenchDescription& description() const { return description_; }
-  const nlohmann::json& devices_json() const { return devices_; }
+  const synbench::Json& devices_json() const { return devices_; }
 
   // Commands. `done` is called on the bench thread once the command was acted on or refused.
   // Enabling starts both drives with the current setpoints; disabling is the ordered stop.
@@ -125,7 +127,7 @@ class BenchRuntime {
 
   std::unique_ptr<BenchBackend> backend_;
   const BenchDescription description_;
-  const nlohmann::json devices_;
+  const synbench::Json devices_;
   Serializer serializer_;
   EventLog log_;
 

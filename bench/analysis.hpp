@@ -5,7 +5,7 @@
 // form is what the REST API serves and the dashboard draws.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json_fwd.hpp"
 
 #include <cstddef>
 #include <optional>
@@ -124,7 +124,7 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
 // Histogram of `values` with bins [k w, (k + 1) w).
 std::vector<HistogramBin> histogram_bins(const std::vector<double>& values, double width);
 
-nlohmann::ordered_json to_json(const Analysis& a);
+synbench::Json to_json(const Analysis& a);
 // One row per curve: MTPA and ME optima, deltas against the reference, position-error summary.
 std::string analysis_curves_csv(const Analysis& a);
 

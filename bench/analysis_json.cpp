@@ -1,7 +1,7 @@
 // JSON form of an analysis (docs/analysis.md): every section an object with a description, the
 // thesis figure it reproduces and its entries; units in the key names; configurations as
 // "estimator" and "pwm" fields as in the point record.
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 namespace synbench::bench {
 namespace {
 
-using ojson = nlohmann::ordered_json;
+using ojson = synbench::Json;
 
 // A JSON document must not carry NaN or infinities (nlohmann writes them as null anyway; this
 // makes it explicit and keeps the C++ side honest).

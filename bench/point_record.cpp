@@ -1,7 +1,7 @@
 // JSON and text forms of a point record.
 #include "bench/point_record.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cstdio>
 #include <sstream>
@@ -9,14 +9,14 @@
 namespace synbench::bench {
 namespace {
 
-nlohmann::ordered_json opt(const std::optional<double>& v) {
-  return v ? nlohmann::ordered_json(*v) : nlohmann::ordered_json(nullptr);
+synbench::Json opt(const std::optional<double>& v) {
+  return v ? synbench::Json(*v) : synbench::Json(nullptr);
 }
 
 }  // namespace
 
-nlohmann::ordered_json to_json(const PointRecord& r) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+synbench::Json to_json(const PointRecord& r) {
+  synbench::Json j = synbench::Json::object();
   j["speed_rpm"] = r.speed_rpm;
   j["load_Nm"] = r.load_Nm;
   j["angle_deg"] = r.angle_deg;
@@ -51,12 +51,12 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
   j["settle_s"] = r.settle_s;
   j["voltage_limited"] = r.voltage_limited;
   j["unstable"] = r.unstable;
-  j["fault"] = r.fault ? nlohmann::ordered_json(*r.fault) : nlohmann::ordered_json(nullptr);
+  j["fault"] = r.fault ? synbench::Json(*r.fault) : synbench::Json(nullptr);
   j["below_min_speed"] = r.below_min_speed;
   j["fallback_fraction"] = r.fallback_fraction;
   j["lock_lost"] = r.lock_lost;
   j["window_source"] = drivers::keeper_name(r.window_source);
-  j["fault_code_raw"] = r.fault_code_raw ? nlohmann::ordered_json(*r.fault_code_raw) : nlohmann::ordered_json(nullptr);
+  j["fault_code_raw"] = r.fault_code_raw ? synbench::Json(*r.fault_code_raw) : synbench::Json(nullptr);
   j["angle_meas_deg"] = opt(r.angle_meas_deg);
   j["angle_off"] = r.angle_off;
   if (r.truth) {
@@ -73,7 +73,7 @@ nlohmann::ordered_json to_json(const PointRecord& r) {
 std::string to_text(const PointRecord& r) {
   std::ostringstream s;
   const auto j = to_json(r);
-  auto line = [&](const std::string& key, const nlohmann::ordered_json& v) {
+  auto line = [&](const std::string& key, const synbench::Json& v) {
     char buf[64];
     if (v.is_number_float()) {
       std::snprintf(buf, sizeof buf, "%.6g", v.get<double>());

@@ -2,7 +2,7 @@
 // used by the JSON output, the database, CSV export and the REST API.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json_fwd.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -53,7 +53,7 @@ struct PointRecord {
   std::optional<drivers::TruthWindow> truth;
 };
 
-nlohmann::ordered_json to_json(const PointRecord& r);
+synbench::Json to_json(const PointRecord& r);
 // The same record for people: one "name  value" line per field.
 std::string to_text(const PointRecord& r);
 

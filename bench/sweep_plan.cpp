@@ -2,7 +2,7 @@
 // (Parsing is in sweep_plan_parse.cpp.)
 #include "bench/sweep_plan.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 namespace synbench::bench {
 namespace {
 
-using ojson = nlohmann::ordered_json;
+using ojson = synbench::Json;
 
 // One (speed, load, configuration) with the angle at a planned point.
 struct Cell {

@@ -4,7 +4,7 @@
 // JSON (stored with the sweep). Pure logic: no I/O besides the JSON given, no clock.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json_fwd.hpp"
 
 #include <array>
 #include <cstddef>
@@ -113,11 +113,11 @@ struct SweepPlanParseResult {
   std::vector<SweepPlanError> errors;   // every problem, not only the first
 };
 
-SweepPlanParseResult parse_sweep_plan(const nlohmann::json& doc);
+SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc);
 
 // Canonical form: every field explicit (defaults filled in, ranges and presets expanded into
 // lists) in a fixed key order. parse_sweep_plan(to_json(p)) gives p back.
-nlohmann::ordered_json to_json(const SweepPlan& plan);
+synbench::Json to_json(const SweepPlan& plan);
 
 // The (speed, load, configuration) curves of a plan, numbered in sweep order. An adaptive search
 // works on one group; in grid mode a group is the angle sweep at one (speed, load, config).
@@ -180,7 +180,7 @@ struct SweepEstimate {
 };
 
 SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& model = {});
-nlohmann::ordered_json to_json(const SweepEstimate& e);
+synbench::Json to_json(const SweepEstimate& e);
 
 // from, from + step, ..., to: inclusive, each value computed as from + i * step (no accumulated
 // error) and rounded to 1e-9, with `to` included when it lies within 1e-6 steps of the grid.

@@ -1,6 +1,6 @@
 // Parsing and validation of sweep plans. Every check names the JSON pointer of what it rejects
 // and parsing goes on after a problem, so a user fixes a plan in one pass.
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +16,7 @@
 namespace synbench::bench {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 constexpr std::size_t kMaxDimensionValues = 10000;  // a range with more is a typo, not a plan
 constexpr std::size_t kMaxPoints = 1000000;
@@ -610,7 +610,7 @@ std::string to_string(const SweepPlanError& e) {
   return (e.json_pointer.empty() ? std::string("(document)") : e.json_pointer) + ": " + e.reason;
 }
 
-SweepPlanParseResult parse_sweep_plan(const nlohmann::json& doc) {
+SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
   Parser p;
   SweepPlanParseResult result;
   if (!doc.is_object()) {

@@ -33,7 +33,7 @@ void append_text(std::string& out, std::string_view s) {
   out += '"';
 }
 
-void append_value(std::string& out, const nlohmann::ordered_json& v) {
+void append_value(std::string& out, const synbench::Json& v) {
   if (v.is_null()) return;
   if (v.is_number_float()) append_number(out, v.get<double>());
   else if (v.is_number_unsigned()) out += std::to_string(v.get<std::uint64_t>());
@@ -44,7 +44,7 @@ void append_value(std::string& out, const nlohmann::ordered_json& v) {
 }
 
 // The truth object's keys, from the record's own JSON form.
-nlohmann::ordered_json truth_template() {
+synbench::Json truth_template() {
   bench::PointRecord r;
   r.truth = drivers::TruthWindow{};
   return bench::to_json(r)["truth"];
@@ -96,10 +96,10 @@ std::string points_to_csv(std::span<const PointRow> rows) {
   return out;
 }
 
-nlohmann::ordered_json points_to_json(std::span<const PointRow> rows) {
-  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+synbench::Json points_to_json(std::span<const PointRow> rows) {
+  synbench::Json out = synbench::Json::array();
   for (const auto& row : rows) {
-    nlohmann::ordered_json j = nlohmann::ordered_json::object();
+    synbench::Json j = synbench::Json::object();
     j["point_index"] = row.index;
     const auto record = bench::to_json(row.record);
     for (const auto& [key, value] : record.items()) j[key] = value;

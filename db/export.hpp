@@ -1,7 +1,7 @@
 // Stored points as CSV and JSON, in the record's one schema (experiment.md Sec. 2.5).
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <span>
 #include <string>
@@ -22,6 +22,6 @@ std::vector<std::string> csv_columns();
 std::string points_to_csv(std::span<const PointRow> rows);
 
 // An array with one object per row: "point_index" first, then exactly bench::to_json's fields.
-nlohmann::ordered_json points_to_json(std::span<const PointRow> rows);
+synbench::Json points_to_json(std::span<const PointRow> rows);
 
 }  // namespace synbench::db

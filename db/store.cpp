@@ -35,14 +35,14 @@ std::string now_utc() {
   return out;
 }
 
-std::optional<std::string> json_text(const nlohmann::ordered_json& j) {
+std::optional<std::string> json_text(const synbench::Json& j) {
   if (j.is_null()) return std::nullopt;
   return j.dump();
 }
 
-Result<nlohmann::ordered_json> json_column(const Statement& st, int i, std::string_view what) {
-  if (st.is_null(i)) return nlohmann::ordered_json(nullptr);
-  auto j = nlohmann::ordered_json::parse(st.text(i), nullptr, /*allow_exceptions=*/false);
+Result<synbench::Json> json_column(const Statement& st, int i, std::string_view what) {
+  if (st.is_null(i)) return synbench::Json(nullptr);
+  auto j = synbench::Json::parse(st.text(i), nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) return make_error(errc::bad_record, std::string(what) + " is not valid JSON");
   return j;
 }
@@ -174,14 +174,14 @@ Status read_record(const Statement& st, int first, bench::PointRecord& r) {
 std::string truth_text(const drivers::TruthWindow& t) {
   // The same object as the record's JSON "truth"; nlohmann writes doubles in their shortest
   // round-trip form, so the values come back bit for bit.
-  const nlohmann::ordered_json j = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W},     {"pfe_W", t.pfe_W},
+  const synbench::Json j = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W},     {"pfe_W", t.pfe_W},
                                     {"pmech_W", t.pmech_W}, {"pinvm_W", t.pinvm_W}, {"pm_W", t.pm_W},
                                     {"temp_C", t.temp_C}};
   return j.dump();
 }
 
 Result<drivers::TruthWindow> parse_truth(const std::string& text) {
-  const auto j = nlohmann::json::parse(text, nullptr, false);
+  const auto j = synbench::Json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return make_error(errc::bad_record, "truth_json is not a JSON object");
   drivers::TruthWindow t;
   const std::pair<const char*, double drivers::TruthWindow::*> fields[] = {
@@ -309,7 +309,7 @@ struct Store::Impl {
     const auto state = parse_sweep_state(st.text(5));
     if (!state) return make_error(errc::bad_record, "sweep " + std::to_string(s.id) + " has an unknown state");
     s.state = *state;
-    const std::pair<int, nlohmann::ordered_json SweepMeta::*> json_columns[] = {
+    const std::pair<int, synbench::Json SweepMeta::*> json_columns[] = {
         {6, &SweepMeta::plan}, {8, &SweepMeta::profiles}, {9, &SweepMeta::bench_config},
         {10, &SweepMeta::calibration}};
     for (const auto& [col, member] : json_columns) {

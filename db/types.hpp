@@ -2,7 +2,7 @@
 // stored points with their index, and events (faults, state changes, log lines).
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -25,11 +25,11 @@ std::optional<SweepState> parse_sweep_state(std::string_view s) noexcept;
 // null are stored as SQL NULL.
 struct SweepMeta {
   std::string name;                           // for people; need not be unique
-  nlohmann::ordered_json plan;                // the sweep plan as run (expanded or as given)
+  synbench::Json plan;                // the sweep plan as run (expanded or as given)
   std::string software_version = kVersion;    // synbench's version
-  nlohmann::ordered_json profiles;            // the device profiles in use
-  nlohmann::ordered_json bench_config;        // the bench configuration in use
-  nlohmann::ordered_json calibration;         // meter/sensor calibration, if any
+  synbench::Json profiles;            // the device profiles in use
+  synbench::Json bench_config;        // the bench configuration in use
+  synbench::Json calibration;         // meter/sensor calibration, if any
   std::int64_t total_points = 0;              // points in the plan: indices 0 .. total_points-1
 };
 

@@ -1,7 +1,7 @@
 // Parsing and validation of bench configs; every problem is reported with its JSON pointer.
 #include "drivers/bench_config.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cmath>
 #include <initializer_list>
@@ -14,7 +14,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 bool is_comment(const std::string& key) { return !key.empty() && key.front() == '_'; }
 

@@ -3,7 +3,7 @@
 // link's timeouts. `synbench point --bench FILE` reads it; docs/bench-config.md is its schema.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json_fwd.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -68,7 +68,7 @@ struct BenchConfigResult {
 };
 
 // `base_dir` resolves relative profile paths.
-BenchConfigResult parse_bench_config(const nlohmann::json& doc, const std::filesystem::path& base_dir);
+BenchConfigResult parse_bench_config(const synbench::Json& doc, const std::filesystem::path& base_dir);
 BenchConfigResult load_bench_config(const std::filesystem::path& file);
 
 // The three profiles a config names, with unit id overrides applied. Profile problems are

@@ -77,8 +77,8 @@ JsonParsed parse_json_text(std::string_view text, const JsonLimits& limits) {
     return out;
   }
   try {
-    out.doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
+    out.doc = synbench::Json::parse(text);
+  } catch (const synbench::Json::exception& e) {
     // parse_error for syntax, out_of_range for a number beyond a double's range (1e309).
     out.doc = nullptr;
     out.error = "not valid JSON: " + parser_message(e.what());

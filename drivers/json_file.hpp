@@ -12,7 +12,7 @@
 #include <string>
 #include <string_view>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 namespace synbench::drivers {
 
@@ -22,7 +22,7 @@ struct JsonLimits {
 };
 
 struct JsonParsed {
-  nlohmann::json doc;  // null when `error` is set
+  synbench::Json doc;  // null when `error` is set
   // Empty on success. For parse_json_text the reason alone ("not valid UTF-8 at byte 12"), to
   // follow a subject ("the body is ..."); for read_json_file "PATH: reason".
   std::string error;

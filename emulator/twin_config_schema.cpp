@@ -1,7 +1,7 @@
 // Parameter table of the twin and the loader, validator and documenter driven by it.
 #include "emulator/twin_config_schema.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cmath>
 #include <limits>
@@ -224,7 +224,7 @@ std::string describe_range(const ParamRow& r) {
   return s.str();
 }
 
-void set_row(const ParamRow& r, const nlohmann::json& v) {
+void set_row(const ParamRow& r, const synbench::Json& v) {
   std::visit(
       [&](auto* f) {
         using T = std::remove_pointer_t<decltype(f)>;
@@ -261,7 +261,7 @@ void set_row(const ParamRow& r, const nlohmann::json& v) {
       r.field);
 }
 
-void walk(const nlohmann::json& node, const std::string& prefix,
+void walk(const synbench::Json& node, const std::string& prefix,
           const std::map<std::string, const ParamRow*>& rows) {
   for (auto it = node.begin(); it != node.end(); ++it) {
     if (!it.key().empty() && it.key()[0] == '_') continue;
@@ -279,13 +279,13 @@ void walk(const nlohmann::json& node, const std::string& prefix,
   }
 }
 
-nlohmann::json row_value(const ParamRow& r) {
-  return std::visit([](auto* f) { return nlohmann::json(*f); }, r.field);
+synbench::Json row_value(const ParamRow& r) {
+  return std::visit([](auto* f) { return synbench::Json(*f); }, r.field);
 }
 
 }  // namespace
 
-void apply_json(TwinConfig& config, const nlohmann::json& doc) {
+void apply_json(TwinConfig& config, const synbench::Json& doc) {
   if (!doc.is_object()) throw ConfigError("(root)", "must be a JSON object");
   auto table = param_table(config);
   std::map<std::string, const ParamRow*> rows;
@@ -337,25 +337,22 @@ void validate(const TwinConfig& c) {
   check_axis(c.synrm.flux_q, "q");
 }
 
-nlohmann::json to_json(const TwinConfig& config) {
+synbench::Json to_json(const TwinConfig& config) {
   TwinConfig copy = config;
-  nlohmann::json out = nlohmann::json::object();
-  for (const auto& r : param_table(copy)) {
-    nlohmann::json::json_pointer ptr("/" + [&] {
-      std::string p = r.key;
-      for (auto& ch : p) if (ch == '.') ch = '/';
-      return p;
-    }());
-    out[ptr] = row_value(r);
-    if (r.assumed) {
-      const auto dot = r.key.rfind('.');
-      std::string section = r.key.substr(0, dot), leaf = r.key.substr(dot + 1);
-      std::string sp = "/" + section;
-      for (auto& ch : sp) if (ch == '.') ch = '/';
-      out[nlohmann::json::json_pointer(sp + "/_assumed")].push_back(leaf);
-    }
+  const auto pointer = [](std::string key) {
+    for (auto& ch : key) if (ch == '.') ch = '/';
+    return synbench::Json::json_pointer("/" + key);
+  };
+  // Keys in the table's order, each section's _assumed after its values.
+  synbench::Json out = {{"_comment", "synbench twin config. Defaults: thesis values; keys listed in a section's _assumed "
+                                     "are our calibration, not from the thesis. See docs/emulator-config.md."}};
+  const auto rows = param_table(copy);
+  for (const auto& r : rows) out[pointer(r.key)] = row_value(r);
+  for (const auto& r : rows) {
+    if (!r.assumed) continue;
+    const auto dot = r.key.rfind('.');
+    out[pointer(r.key.substr(0, dot) + "._assumed")].push_back(r.key.substr(dot + 1));
   }
-  out["_comment"] = "synbench twin config. Defaults: thesis values; keys listed in a section's _assumed are our calibration, not from the thesis. See docs/emulator-config.md.";
   return out;
 }
 

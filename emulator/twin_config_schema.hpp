@@ -3,7 +3,8 @@
 // and the documentation are all generated from this one table, so they cannot drift apart.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json.hpp"
+
 
 #include <stdexcept>
 #include <string>
@@ -43,7 +44,7 @@ std::vector<ParamRow> param_table(TwinConfig& config);
 
 // Overlays a (possibly partial) JSON document on `config`. Keys starting with '_' are comments.
 // Throws ConfigError naming the first bad key.
-void apply_json(TwinConfig& config, const nlohmann::json& doc);
+void apply_json(TwinConfig& config, const synbench::Json& doc);
 
 // Reads and applies a JSON file; a parse error names the file, line and column.
 TwinConfig load_twin_config_file(const std::string& path);
@@ -52,7 +53,7 @@ TwinConfig load_twin_config_file(const std::string& path);
 void validate(const TwinConfig& config);
 
 // The full config as JSON, with a per-section "_assumed" list of the keys that are our calibration.
-nlohmann::json to_json(const TwinConfig& config);
+synbench::Json to_json(const TwinConfig& config);
 
 // Markdown table of every key: default, range, source, meaning.
 std::string markdown_reference(const TwinConfig& config);

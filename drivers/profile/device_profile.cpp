@@ -2,7 +2,7 @@
 // rejects, so an error message leads a user straight to the line to fix.
 #include "drivers/profile/device_profile.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <array>
@@ -23,7 +23,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 constexpr std::array<std::string_view, 4> kRegisterKindNames{"coil", "discrete_input", "holding", "input"};
 constexpr std::array<std::string_view, 3> kAccessNames{"r", "w", "rw"};
@@ -573,7 +573,7 @@ std::string json_pointer_token(std::string_view key) {
   return out;
 }
 
-ProfileParseResult parse_device_profile(const nlohmann::json& doc) {
+ProfileParseResult parse_device_profile(const synbench::Json& doc) {
   Parser p;
   if (!doc.is_object()) {
     p.fail("", "a profile must be a JSON object");

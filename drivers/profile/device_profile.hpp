@@ -3,7 +3,8 @@
 // is the schema for those users; parse_device_profile is its one implementation.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json.hpp"
+
 
 #include <cstdint>
 #include <filesystem>
@@ -132,7 +133,7 @@ struct ProfileParseResult {
   std::vector<ProfileError> errors;
 };
 
-ProfileParseResult parse_device_profile(const nlohmann::json& doc);
+ProfileParseResult parse_device_profile(const synbench::Json& doc);
 
 // Reads and parses a profile file; unreadable files and JSON syntax errors are reported at
 // path "" with the file name in the reason.

@@ -3,7 +3,7 @@
 // group named, and a signal of the other meter kind says which kind it belongs to.
 #include "drivers/profile/window_schema.hpp"
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <array>
 #include <cmath>
@@ -13,7 +13,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 using Names = std::span<const std::string_view>;
 
 constexpr std::array<std::string_view, 3> kMeterNames{"gate", "totalizer", "power"};
@@ -180,7 +180,7 @@ std::optional<MeterKind> parse_meter_kind(std::string_view s) {
   return std::nullopt;
 }
 
-void parse_window_schema(const nlohmann::json& doc, DeviceProfile& profile, std::vector<ProfileError>& errors) {
+void parse_window_schema(const synbench::Json& doc, DeviceProfile& profile, std::vector<ProfileError>& errors) {
   static const json kNoSignals = json::object();
   const auto it = doc.find("signals");
   Check c{doc, it != doc.end() && it->is_object() ? *it : kNoSignals, errors};

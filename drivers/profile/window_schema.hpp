@@ -4,7 +4,8 @@
 // own required signals. Part of parse_device_profile; docs/device-profile.md is the schema.
 #pragma once
 
-#include <nlohmann/json_fwd.hpp>
+#include "drivers/json.hpp"
+
 
 #include <optional>
 #include <string_view>
@@ -19,7 +20,7 @@ std::optional<MeterKind> parse_meter_kind(std::string_view s);
 
 // Reads the top-level window and meter keys of `doc` into `profile` (kind already set) and
 // checks that the signals `doc` maps form the groups they require. Errors carry JSON pointers.
-void parse_window_schema(const nlohmann::json& doc, DeviceProfile& profile, std::vector<ProfileError>& errors);
+void parse_window_schema(const synbench::Json& doc, DeviceProfile& profile, std::vector<ProfileError>& errors);
 
 // Whether the bench keeps this device's window from polled telemetry (a drive without window
 // signals, a power meter) rather than the device.

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "drivers/bench_check.hpp"
 #include "drivers/profile_devices/probe.hpp"
@@ -70,13 +70,13 @@ void print_table(const std::vector<drivers::ProbeRow>& rows) {
   }
 }
 
-nlohmann::json row_json(const drivers::ProbeRow& r) {
-  nlohmann::json j{{"device", drivers::name(r.device)}, {"profile", r.profile}, {"signal", r.signal},
+synbench::Json row_json(const drivers::ProbeRow& r) {
+  synbench::Json j{{"device", drivers::name(r.device)}, {"profile", r.profile}, {"signal", r.signal},
                    {"table", drivers::name(r.table)},   {"address", r.address}, {"count", r.count},
                    {"unit_id", r.unit_id},              {"raw", r.raw},         {"unit", r.unit}};
-  j["value"] = r.value ? nlohmann::json(*r.value) : nlohmann::json(nullptr);
-  j["label"] = r.label.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.label);
-  j["error"] = r.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.error);
+  j["value"] = r.value ? synbench::Json(*r.value) : synbench::Json(nullptr);
+  j["label"] = r.label.empty() ? synbench::Json(nullptr) : synbench::Json(r.label);
+  j["error"] = r.error.empty() ? synbench::Json(nullptr) : synbench::Json(r.error);
   return j;
 }
 
@@ -118,7 +118,7 @@ int bench_check_command(const std::vector<std::string>& argv) {
     return 1;
   }
   const drivers::BenchConfig& config = *r.config;
-  nlohmann::json out{{"file", file}, {"ok", true}, {"devices", nlohmann::json::array()}};
+  synbench::Json out{{"file", file}, {"ok", true}, {"devices", synbench::Json::array()}};
   if (!json) std::cout << file << ": ok\n";
   for (const drivers::DeviceKind k : drivers::kDeviceKinds) {
     const drivers::DeviceProfile& p = profile_of(*profiles, k);
@@ -131,7 +131,7 @@ int bench_check_command(const std::vector<std::string>& argv) {
   }
   // Not a problem, but what the supervisor will not see: said before anyone relies on it.
   const auto blind = drivers::frozen_check_blind_spots(*profiles);
-  out["frozen_check_unwatched"] = nlohmann::json::array();
+  out["frozen_check_unwatched"] = synbench::Json::array();
   for (const auto& b : blind)
     out["frozen_check_unwatched"].push_back(
         {{"signal", b.signal}, {"step", b.step}, {"noise", b.noise}, {"unit", b.unit}, {"reason", b.describe()}});
@@ -151,7 +151,7 @@ int bench_check_command(const std::vector<std::string>& argv) {
     std::size_t failed = 0;
     for (const auto& row : rows) failed += row.value ? 0 : 1;
     if (json) {
-      out["probe"] = nlohmann::json::array();
+      out["probe"] = synbench::Json::array();
       for (const auto& row : rows) out["probe"].push_back(row_json(row));
       out["ok"] = failed == 0;
     } else {

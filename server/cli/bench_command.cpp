@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "app/bench_backend.hpp"
 #include "app/supervised_point.hpp"
@@ -51,8 +51,8 @@ faulted, or runs, 2 bad input
 namespace {
 
 
-nlohmann::json drives_json(const bench::SafetySupervisor& s) {
-  nlohmann::json j;
+synbench::Json drives_json(const bench::SafetySupervisor& s) {
+  synbench::Json j;
   if (const auto& t = s.synrm())
     j["synrm"] = {{"state", drivers::state_name(t->state)}, {"fault", std::string(drivers::fault_name(t->fault))},
                   {"speed_rpm", t->speed_rpm}, {"im_A", t->im_A}, {"udc_V", t->udc_V}};
@@ -66,7 +66,7 @@ nlohmann::json drives_json(const bench::SafetySupervisor& s) {
   return j;
 }
 
-void print(const nlohmann::json& j, bool json) {
+void print(const synbench::Json& j, bool json) {
   if (json) {
     std::cout << j.dump() << "\n";
     return;

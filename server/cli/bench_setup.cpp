@@ -52,8 +52,8 @@ std::string ConfiguredBench::describe() const {
   return s;
 }
 
-nlohmann::json ConfiguredBench::describe_devices() const {
-  nlohmann::json out = nlohmann::json::array();
+synbench::Json ConfiguredBench::describe_devices() const {
+  synbench::Json out = synbench::Json::array();
   const std::pair<const char*, const drivers::DeviceConfig*> devices[] = {
       {"synrm", &config_.synrm_drive}, {"load", &config_.load_drive}, {"meter", &config_.vfc_meter}};
   const char* kinds[] = {"synrm_drive", "load_drive", "vfc_meter"};
@@ -146,7 +146,7 @@ class ConfiguredBackend final : public app::BenchBackend {
   bool ticks_pending() const override { return bench_.bench().resets_pending(); }
   void set_heartbeats(bool on) override { bench_.bench().set_heartbeats(on); }
   bool heartbeats() const override { return bench_.bench().heartbeats(); }
-  nlohmann::json describe() const override { return bench_.describe_devices(); }
+  synbench::Json describe() const override { return bench_.describe_devices(); }
   const app::BenchDescription& description() const override { return description_; }
   std::string link_errors() const override { return bench_.link_errors(); }
   std::string links() const override { return bench_.describe(); }
@@ -162,11 +162,11 @@ class TwinBackend final : public app::BenchBackend {
   explicit TwinBackend(const emulator::TwinConfig& config) : twin_(config), description_(twin_description(config)) {}
   drivers::BenchDevices devices() override { return twin_.devices(); }
   drivers::Clock& clock() override { return twin_.clock(); }
-  nlohmann::json describe() const override {
+  synbench::Json describe() const override {
     const auto dev = [](const char* role, const char* kind) {
-      return nlohmann::json{{"role", role}, {"kind", kind}, {"backend", "twin"}, {"link", "in-process"}, {"profile", nullptr}};
+      return synbench::Json{{"role", role}, {"kind", kind}, {"backend", "twin"}, {"link", "in-process"}, {"profile", nullptr}};
     };
-    return nlohmann::json::array({dev("synrm", "synrm_drive"), dev("load", "load_drive"), dev("meter", "vfc_meter"),
+    return synbench::Json::array({dev("synrm", "synrm_drive"), dev("load", "load_drive"), dev("meter", "vfc_meter"),
                                   dev("trigger", "window_trigger"), dev("truth", "truth_probe")});
   }
   const app::BenchDescription& description() const override { return description_; }

@@ -8,7 +8,7 @@
 #include <map>
 #include <optional>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 #include <memory>
 #include <string>
 
@@ -53,7 +53,7 @@ class ConfiguredBench {
   // The last error of each link that had one, one per line.
   std::string link_errors() const;
   // The devices as GET /api/devices lists them.
-  nlohmann::json describe_devices() const;
+  synbench::Json describe_devices() const;
 
  private:
   drivers::BenchConfig config_;

@@ -1,5 +1,5 @@
 // `synbench config`: prints the default twin config, its reference table, or checks a file.
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <iostream>
 

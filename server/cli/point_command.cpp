@@ -1,6 +1,6 @@
 // `synbench point`: one operating point on the in-process twin, on virtual time; or, with
 // --bench, through device profiles and Modbus links (hardware, `synbench emulate`).
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <iostream>
 #include <memory>

@@ -162,12 +162,12 @@ int serve_command(const std::vector<std::string>& argv) {
   http::ControlLock control;
   http::add_api_routes(router, {bench, config, control, metrics, synbench::kVersion});
   // Stored with every sweep created here: the twin's config, or the bench config of the drives.
-  nlohmann::ordered_json bench_meta = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+  synbench::Json bench_meta = emulator::to_json(config);
   if (options.bench) {
     std::ifstream in(*options.bench);
     bench_meta = {{"bench_file", options.bench->string()},
-                  {"bench", nlohmann::ordered_json::parse(in, nullptr, false)},
-                  {"devices", nlohmann::ordered_json::parse(bench.devices_json().dump())}};
+                  {"bench", synbench::Json::parse(in, nullptr, false)},
+                  {"devices", bench.devices_json()}};
   }
   // The estimate, exports and analyses on a thread of their own: the io thread stays free for
   // the E-stop.

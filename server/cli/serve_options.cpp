@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <set>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "drivers/json_file.hpp"
 #include "emulator/twin_config_schema.hpp"
@@ -37,7 +37,7 @@ struct FileSettings {
   std::optional<std::string> listen;
   bool allow_remote_plain_http = false;
   std::optional<std::filesystem::path> data_dir, web_dir, bench;
-  std::optional<nlohmann::json> twin;  // an object, or a file name resolved to its contents
+  std::optional<synbench::Json> twin;  // an object, or a file name resolved to its contents
   std::optional<std::filesystem::path> twin_file;
   std::vector<std::string> allow_hosts, allow_origins;
 };
@@ -46,7 +46,7 @@ FileSettings read_config_file(const std::filesystem::path& file, const std::stri
   // "cannot read PATH: cannot open: No such file or directory", "cannot read PATH: not valid JSON: ..."
   drivers::JsonParsed read = drivers::read_json_file(file);
   if (!read.ok()) throw UsageError(flag, "cannot read " + read.error);
-  const nlohmann::json& doc = read.doc;
+  const synbench::Json& doc = read.doc;
   if (!doc.is_object()) throw UsageError(flag, file.string() + ": the top level must be an object");
   const auto base = file.parent_path();
   const auto at = [&](const std::string& key, const std::string& reason) {

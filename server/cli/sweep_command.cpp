@@ -1,6 +1,6 @@
 // `synbench sweep`: runs a sweep plan headless on the in-process twin, every point committed to
 // the SQLite store as it is measured; resumable after a crash or an abort; exports and analysis.
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -219,7 +219,7 @@ int sweep_command(const std::vector<std::string>& argv) {
       std::cerr << "synbench sweep: --resume " << *resume << ": the sweep is already completed\n";
       return 2;
     }
-    auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(sweep->meta.plan.dump()));
+    auto parsed = bench::parse_sweep_plan(sweep->meta.plan);
     if (!parsed.plan) {
       std::cerr << "synbench sweep: --resume " << *resume << ": its stored plan no longer parses: "
                 << bench::to_string(parsed.errors.front()) << "\n";
@@ -239,9 +239,9 @@ int sweep_command(const std::vector<std::string>& argv) {
     meta.plan = bench::to_json(*plan);
     if (loaded) {
       std::ifstream in(bench_file);
-      meta.bench_config = {{"bench_file", bench_file}, {"bench", nlohmann::ordered_json::parse(in, nullptr, false)}};
+      meta.bench_config = {{"bench_file", bench_file}, {"bench", synbench::Json::parse(in, nullptr, false)}};
     } else {
-      meta.bench_config = nlohmann::ordered_json::parse(emulator::to_json(config).dump());
+      meta.bench_config = emulator::to_json(config);
     }
     const auto est = bench::estimate(*plan);
     meta.total_points = static_cast<std::int64_t>(est.points);

@@ -24,7 +24,7 @@ std::map<int, std::uint64_t> HttpMetrics::by_status() const {
   return by_status_;
 }
 
-std::variant<nlohmann::json, Response> parse_json_object(const std::string& body) {
+std::variant<synbench::Json, Response> parse_json_object(const std::string& body) {
   if (body.empty()) return error_response(400, "bad_json", "the request needs a JSON object body");
   // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
   // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
@@ -62,7 +62,7 @@ BenchRuntime::Done answer(Reply reply, int ok_status) {
 namespace {
 
 // Rejects fields other than `known`, so a typo ("speed") is an error instead of a no-op.
-std::optional<Response> unknown_fields(const nlohmann::json& doc, const std::set<std::string>& known) {
+std::optional<Response> unknown_fields(const synbench::Json& doc, const std::set<std::string>& known) {
   for (const auto& [k, v] : doc.items())
     if (!known.count(k)) {
       std::string list;
@@ -72,7 +72,7 @@ std::optional<Response> unknown_fields(const nlohmann::json& doc, const std::set
   return std::nullopt;
 }
 
-nlohmann::json number_schema(double min, double max, const std::string& desc) {
+synbench::Json number_schema(double min, double max, const std::string& desc) {
   return {{"type", "number"}, {"minimum", min}, {"maximum", max}, {"description", desc}};
 }
 
@@ -123,33 +123,33 @@ const char* phase_name(bench::SafetyPhase p) {
 namespace {
 
 // A stop's disable per drive (bench/disable_report.hpp).
-nlohmann::json disable_json(const bench::DisableReport& r) {
+synbench::Json disable_json(const bench::DisableReport& r) {
   const auto drive = [](const bench::DriveDisable& d) {
-    return nlohmann::json{{"state", std::string(bench::name(d.state))},
+    return synbench::Json{{"state", std::string(bench::name(d.state))},
                           {"first_acknowledged", d.first_acknowledged},
                           {"attempts", d.attempts},
-                          {"error", d.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.error)},
-                          {"confirmed_s", d.confirmed_s ? nlohmann::json(*d.confirmed_s) : nlohmann::json(nullptr)},
+                          {"error", d.error.empty() ? synbench::Json(nullptr) : synbench::Json(d.error)},
+                          {"confirmed_s", d.confirmed_s ? synbench::Json(*d.confirmed_s) : synbench::Json(nullptr)},
                           {"setpoint_zeroed", d.setpoint_zeroed}};
   };
   return {{"at_s", r.at_s}, {"confirmed", r.confirmed()}, {"synrm", drive(r.synrm)}, {"load", drive(r.load)}};
 }
 
 // A drive's own code of a fault its profile has no label for (fault "unknown"), else null.
-nlohmann::json raw_code(const std::optional<std::int64_t>& code) {
-  return code ? nlohmann::json(*code) : nlohmann::json(nullptr);
+synbench::Json raw_code(const std::optional<std::int64_t>& code) {
+  return code ? synbench::Json(*code) : synbench::Json(nullptr);
 }
 
-nlohmann::json object_schema(nlohmann::json properties, bool nullable = false) {
-  nlohmann::json o = {{"type", "object"}, {"properties", std::move(properties)}};
+synbench::Json object_schema(synbench::Json properties, bool nullable = false) {
+  synbench::Json o = {{"type", "object"}, {"properties", std::move(properties)}};
   if (nullable) o["nullable"] = true;
   return o;
 }
 
 // disable_json()'s object for the OpenAPI document: null until a stop's disable was sent.
-nlohmann::json disable_schema() {
-  const nlohmann::json str = {{"type", "string"}}, boolean = {{"type", "boolean"}};
-  const nlohmann::json drive = object_schema(
+synbench::Json disable_schema() {
+  const synbench::Json str = {{"type", "string"}}, boolean = {{"type", "boolean"}};
+  const synbench::Json drive = object_schema(
       {{"state", {{"type", "string"}, {"enum", {"acknowledged", "repeating", "confirmed"}}}},
        {"first_acknowledged", boolean},
        {"attempts", {{"type", "integer"}}},
@@ -160,10 +160,10 @@ nlohmann::json disable_schema() {
 }
 
 // The status object of status_json() for the OpenAPI document (docs/api.md, "Status").
-nlohmann::json status_schema() {
-  const nlohmann::json num = {{"type", "number"}}, boolean = {{"type", "boolean"}}, str = {{"type", "string"}};
-  const nlohmann::json nullable_num = {{"type", "number"}, {"nullable", true}};
-  const nlohmann::json code_raw = {{"type", "integer"}, {"nullable", true},
+synbench::Json status_schema() {
+  const synbench::Json num = {{"type", "number"}}, boolean = {{"type", "boolean"}}, str = {{"type", "string"}};
+  const synbench::Json nullable_num = {{"type", "number"}, {"nullable", true}};
+  const synbench::Json code_raw = {{"type", "integer"}, {"nullable", true},
                                    {"description", "the device's own code of a fault its profile has no label for "
                                                    "(fault unknown), else null"}};
   return object_schema(
@@ -197,8 +197,8 @@ nlohmann::json status_schema() {
 
 }  // namespace
 
-nlohmann::json status_json(const BenchStatus& s) {
-  nlohmann::json j;
+synbench::Json status_json(const BenchStatus& s) {
+  synbench::Json j;
   j["t_s"] = s.t_s;
   j["enabled"] = s.enabled;
   j["stopping"] = s.stopping;
@@ -209,8 +209,8 @@ nlohmann::json status_json(const BenchStatus& s) {
     const auto& t = *s.synrm;
     j["synrm"] = {{"speed_rpm", t.speed_rpm}, {"im_A", t.im_A},     {"id_A", t.id_A},     {"iq_A", t.iq_A},
                   {"ud_V", t.ud_V},           {"uq_V", t.uq_V},     {"udc_V", t.udc_V},   {"pac_W", t.pac_W},
-                  {"temp_C", t.temp_C ? nlohmann::json(*t.temp_C) : nlohmann::json(nullptr)},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
-                  {"pos_err_deg", t.pos_err_deg ? nlohmann::json(*t.pos_err_deg) : nlohmann::json(nullptr)},
+                  {"temp_C", t.temp_C ? synbench::Json(*t.temp_C) : synbench::Json(nullptr)},       {"voltage_limited", t.voltage_limited}, {"lock_lost", t.lock_lost},
+                  {"pos_err_deg", t.pos_err_deg ? synbench::Json(*t.pos_err_deg) : synbench::Json(nullptr)},
                   {"state", drivers::state_name(t.state)}, {"fault", std::string(drivers::fault_name(t.fault))},
                   {"fault_code_raw", raw_code(t.fault_code_raw)}};
   } else {
@@ -229,15 +229,15 @@ nlohmann::json status_json(const BenchStatus& s) {
                                {"fault_code_raw", raw_code(s.trip->fault_code_raw)},
                                {"detail", s.trip->detail},
                                {"at_s", s.trip->at_s}};
-  j["supervisor"]["alarm"] = s.alarm ? nlohmann::json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : nlohmann::json(nullptr);
-  j["supervisor"]["disable"] = s.disable ? disable_json(*s.disable) : nlohmann::json(nullptr);
+  j["supervisor"]["alarm"] = s.alarm ? synbench::Json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : synbench::Json(nullptr);
+  j["supervisor"]["disable"] = s.disable ? disable_json(*s.disable) : synbench::Json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
   if (s.sweep)
     j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
                   {"error", s.sweep->error}};
   else
     j["sweep"] = nullptr;
-  nlohmann::json ev = nlohmann::json::array();
+  synbench::Json ev = synbench::Json::array();
   for (const auto& e : s.events) ev.push_back({{"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
   j["events"] = ev;
   return j;
@@ -354,20 +354,20 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<nlohmann::json>(parsed);
+                const auto& doc = std::get<synbench::Json>(parsed);
                 if (auto r = unknown_fields(doc, {"enabled"})) return reply(*r);
                 if (!doc.contains("enabled")) return reply(bad_field("enabled", "required"));
                 if (!doc["enabled"].is_boolean()) return reply(bad_field("enabled", "must be true or false"));
                 bench->enable(doc["enabled"].get<bool>(), answer(std::move(reply)));
               }),
-              nlohmann::json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
+              synbench::Json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
   router.add({"POST", "/api/bench/mode", Role::operator_,
               "Choose the estimator and/or PWM scheme manual operation runs with (drives disabled).",
               AsyncHandler([bench, control](const Request& req, Reply reply) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<nlohmann::json>(parsed);
+                const auto& doc = std::get<synbench::Json>(parsed);
                 if (auto r = unknown_fields(doc, {"estimator", "pwm"})) return reply(*r);
                 if (doc.empty()) return reply(error_response(400, "bad_field", "give estimator and/or pwm"));
                 app::DriveModeUpdate mode;
@@ -383,7 +383,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 }
                 bench->set_mode(mode, answer(std::move(reply)));
               }),
-              nlohmann::json{{"type", "object"},
+              synbench::Json{{"type", "object"},
                              {"additionalProperties", false},
                              {"properties",
                               {{"estimator", {{"type", "string"}, {"enum", drivers::kEstimatorNames}}},
@@ -394,7 +394,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<nlohmann::json>(parsed);
+                const auto& doc = std::get<synbench::Json>(parsed);
                 if (auto r = unknown_fields(doc, {"speed_rpm", "load_Nm", "angle_deg"})) return reply(*r);
                 if (doc.empty())
                   return reply(error_response(400, "bad_field", "give at least one of speed_rpm, load_Nm, angle_deg"));
@@ -421,7 +421,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 }
                 bench->set_setpoints(sp, answer(std::move(reply)));
               }),
-              nlohmann::json{{"type", "object"},
+              synbench::Json{{"type", "object"},
                              {"additionalProperties", false},
                              {"properties",
                               {{"speed_rpm", number_schema(0, max_speed_rpm, "SynRM speed setpoint")},

@@ -3,6 +3,8 @@
 // the JSON answer; docs/api.md describes every route.
 #pragma once
 
+#include "drivers/json.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -94,7 +96,7 @@ class ControlLock {
     }
     return false;
   }
-  nlohmann::json describe() const {
+  synbench::Json describe() const {
     std::lock_guard lock(mutex_);
     const auto idle_s = std::chrono::duration<double>(Clock::now() - last_).count();
     if (holder_.empty() || idle_s > static_cast<double>(kIdle.count())) return {{"holder", nullptr}};
@@ -123,9 +125,9 @@ void add_api_routes(Router& router, ApiContext ctx);
 
 // Request parsing helpers shared by handlers; exposed for tests.
 // The body as a JSON object, or a 400 response naming the problem.
-std::variant<nlohmann::json, Response> parse_json_object(const std::string& body);
+std::variant<synbench::Json, Response> parse_json_object(const std::string& body);
 
-nlohmann::json status_json(const BenchStatus& s);
+synbench::Json status_json(const BenchStatus& s);
 // The bench's refusal as an HTTP status: 409 for the bench's state, 502 for a device, 503 while
 // the daemon stops or its queue is full, 500 for the store.
 int http_status(app::Refused r);

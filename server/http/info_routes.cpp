@@ -11,15 +11,15 @@ namespace synbench::http {
 namespace {
 
 // What each position source is and what it needs, for a client choosing one (physics.md 8).
-nlohmann::json estimators_json(const emulator::TwinConfig& c) {
+synbench::Json estimators_json(const emulator::TwinConfig& c) {
   const auto& e = c.estimators;
-  nlohmann::json out = nlohmann::json::array();
-  const auto add = [&out](drivers::Estimator est, bool sensorless, const char* description, nlohmann::json extra) {
-    nlohmann::json j = {{"name", std::string(drivers::name(est))}, {"sensorless", sensorless}, {"description", description}};
+  synbench::Json out = synbench::Json::array();
+  const auto add = [&out](drivers::Estimator est, bool sensorless, const char* description, synbench::Json extra) {
+    synbench::Json j = {{"name", std::string(drivers::name(est))}, {"sensorless", sensorless}, {"description", description}};
     j.update(extra);
     out.push_back(std::move(j));
   };
-  const nlohmann::json eemf_range = {{"min_speed_rpm", e.eemf.min_speed_rpm},
+  const synbench::Json eemf_range = {{"min_speed_rpm", e.eemf.min_speed_rpm},
                                      {"handover_hysteresis_rpm", e.eemf.handover_hysteresis_rpm},
                                      {"low_speed_source", e.eemf.low_speed_source}};
   add(drivers::Estimator::encoder, false, "incremental encoder: the reference", {{"min_speed_rpm", 0}});
@@ -28,13 +28,13 @@ nlohmann::json estimators_json(const emulator::TwinConfig& c) {
       {{"min_speed_rpm", 0}, {"rs_speed_threshold_rpm", e.ekf.rs_speed_threshold_rpm}});
   add(drivers::Estimator::hfi, true, "high-frequency injection (saliency tracking)",
       {{"min_speed_rpm", 0}, {"injection", {{"voltage_V", e.hfi.voltage_V}, {"frequency_Hz", e.hfi.frequency_Hz}}}});
-  nlohmann::json lut = eemf_range;
+  synbench::Json lut = eemf_range;
   lut["lut_ld_scale"] = e.eemf.lut_ld_scale;
   lut["lut_lq_scale"] = e.eemf.lut_lq_scale;
-  nlohmann::json cst = eemf_range;
+  synbench::Json cst = eemf_range;
   cst["ld_H"] = e.eemf.ld_H;
   cst["lq_H"] = e.eemf.lq_H;
-  nlohmann::json rls = eemf_range;
+  synbench::Json rls = eemf_range;
   rls["injection"] = {{"prbs_voltage_V", e.eemf.prbs_voltage_V}, {"prbs_bit_s", e.eemf.prbs_bit_s}};
   add(drivers::Estimator::eemf_const, true, "extended EMF observer, constant inductances", cst);
   add(drivers::Estimator::eemf_lut, true, "extended EMF observer, inductance tables", lut);
@@ -42,21 +42,21 @@ nlohmann::json estimators_json(const emulator::TwinConfig& c) {
   return out;
 }
 
-nlohmann::json profiles_json() {
-  nlohmann::json out = nlohmann::json::array();
+synbench::Json profiles_json() {
+  synbench::Json out = synbench::Json::array();
   for (const auto kind : drivers::kDeviceKinds) {
     const auto file = drivers::default_profile_path(kind);
-    nlohmann::json j = {{"kind", std::string(drivers::name(kind))}, {"file", file.filename().string()}};
+    synbench::Json j = {{"kind", std::string(drivers::name(kind))}, {"file", file.filename().string()}};
     const auto parsed = drivers::load_device_profile(file);
     if (parsed.profile) {
       std::ifstream in(file);
       std::stringstream text;
       text << in.rdbuf();
       j["valid"] = true;
-      j["profile"] = nlohmann::json::parse(text.str(), nullptr, false);
+      j["profile"] = synbench::Json::parse(text.str(), nullptr, false);
     } else {
       j["valid"] = false;
-      nlohmann::json errors = nlohmann::json::array();
+      synbench::Json errors = synbench::Json::array();
       for (const auto& e : parsed.errors) errors.push_back({{"path", e.path}, {"reason", e.reason}});
       j["errors"] = errors;
     }
@@ -70,7 +70,7 @@ nlohmann::json profiles_json() {
 void add_info_routes(Router& router, const BenchRuntime& bench, const emulator::TwinConfig& twin) {
   router.add({"GET", "/api/whoami", Role::viewer, "The caller's role and identity label (never the token).",
               [](const Request& req) { return json_response(200, {{"role", role_name(req.caller)}, {"id", req.caller_id}}); }});
-  const nlohmann::json estimators = estimators_json(twin);
+  const synbench::Json estimators = estimators_json(twin);
   router.add({"GET", "/api/estimators", Role::viewer,
               "Position sources the SynRM drive offers (POST /api/bench/mode selects one), with their speed ranges.",
               [estimators](const Request&) { return json_response(200, estimators); }});

@@ -29,12 +29,11 @@ std::optional<Role> parse_role(std::string_view name) {
   return std::nullopt;
 }
 
-std::string dump_json(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
-std::string dump_json(const nlohmann::ordered_json& j) {
-  return j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+std::string dump_json(const synbench::Json& j) {
+  return j.dump(-1, ' ', false, synbench::Json::error_handler_t::replace);
 }
 
-Response json_response(int status, const nlohmann::json& body) {
+Response json_response(int status, const synbench::Json& body) {
   Response r;
   r.status = status;
   r.body = dump_json(body);
@@ -230,16 +229,16 @@ void Router::route_and_call(const std::string& method, const std::string& target
   reply(route->handler(req));
 }
 
-nlohmann::json Router::openapi(const std::string& title, const std::string& version) const {
-  nlohmann::json paths = nlohmann::json::object();
+synbench::Json Router::openapi(const std::string& title, const std::string& version) const {
+  synbench::Json paths = synbench::Json::object();
   for (const Route& r : routes_) {
-    nlohmann::json op;
+    synbench::Json op;
     op["summary"] = r.summary;
     op["operationId"] = ascii_lower(r.method) + r.pattern;
     op["x-synbench-role"] = role_name(r.role);
-    if (r.role != Role::anyone) op["security"] = nlohmann::json::array({{{"bearer", nlohmann::json::array()}}});
-    else op["security"] = nlohmann::json::array();
-    nlohmann::json params = nlohmann::json::array();
+    if (r.role != Role::anyone) op["security"] = synbench::Json::array({{{"bearer", synbench::Json::array()}}});
+    else op["security"] = synbench::Json::array();
+    synbench::Json params = synbench::Json::array();
     for (auto seg : segments(r.pattern))
       if (seg.size() > 2 && seg.front() == '{')
         params.push_back({{"name", std::string(seg.substr(1, seg.size() - 2))}, {"in", "path"}, {"required", true},
@@ -247,9 +246,9 @@ nlohmann::json Router::openapi(const std::string& title, const std::string& vers
     if (!params.empty()) op["parameters"] = params;
     if (r.request_schema)
       op["requestBody"] = {{"required", true}, {"content", {{"application/json", {{"schema", *r.request_schema}}}}}};
-    nlohmann::json ok = {{"description", "success"}};
+    synbench::Json ok = {{"description", "success"}};
     if (r.response_schema) ok["content"] = {{"application/json", {{"schema", *r.response_schema}}}};
-    nlohmann::json responses = {{"200", ok},
+    synbench::Json responses = {{"200", ok},
                                 {"default", {{"description", "error"},
                                              {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}}};
     if (r.role != Role::anyone) {

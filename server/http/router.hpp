@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 namespace synbench::http {
 
@@ -41,9 +41,8 @@ struct Response {
 
 // Serialises `j`, writing any string that is not UTF-8 with U+FFFD instead of throwing: every
 // JSON the daemon sends goes through here, as request-derived text can hold any byte.
-std::string dump_json(const nlohmann::json& j);
-std::string dump_json(const nlohmann::ordered_json& j);
-Response json_response(int status, const nlohmann::json& body);
+std::string dump_json(const synbench::Json& j);
+Response json_response(int status, const synbench::Json& body);
 // {"error": {"code": code, "message": message}}
 Response error_response(int status, const std::string& code, const std::string& message);
 // Runs `make`; an exception it throws becomes a 500 `internal` answer and a line on stderr
@@ -57,10 +56,10 @@ using Reply = std::function<void(Response)>;
 using AsyncHandler = std::function<void(const Request&, Reply)>;
 
 struct Route {
-  Route(std::string m, std::string p, Role r, std::string s, Handler h, std::optional<nlohmann::json> schema = std::nullopt)
+  Route(std::string m, std::string p, Role r, std::string s, Handler h, std::optional<synbench::Json> schema = std::nullopt)
       : method(std::move(m)), pattern(std::move(p)), role(r), summary(std::move(s)), handler(std::move(h)),
         request_schema(std::move(schema)) {}
-  Route(std::string m, std::string p, Role r, std::string s, AsyncHandler h, std::optional<nlohmann::json> schema = std::nullopt)
+  Route(std::string m, std::string p, Role r, std::string s, AsyncHandler h, std::optional<synbench::Json> schema = std::nullopt)
       : method(std::move(m)), pattern(std::move(p)), role(r), summary(std::move(s)), async_handler(std::move(h)),
         request_schema(std::move(schema)) {}
   std::string method;
@@ -69,8 +68,8 @@ struct Route {
   std::string summary;  // one line, for the OpenAPI document and docs/api.md
   Handler handler;             // one of the two
   AsyncHandler async_handler;
-  std::optional<nlohmann::json> request_schema;  // JSON Schema of the body, if it takes one
-  std::optional<nlohmann::json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
+  std::optional<synbench::Json> request_schema;  // JSON Schema of the body, if it takes one
+  std::optional<synbench::Json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
 };
 
 // A token's role and a label naming its holder in messages and the control lock (the first
@@ -103,7 +102,7 @@ class Router {
   std::optional<Identity> identify(std::string_view authorization) const;
 
   // OpenAPI 3.0 document generated from the table.
-  nlohmann::json openapi(const std::string& title, const std::string& version) const;
+  synbench::Json openapi(const std::string& title, const std::string& version) const;
 
  private:
   // dispatch_async's body; may throw, which dispatch_async turns into a 500.

@@ -19,12 +19,12 @@ namespace synbench::http {
 namespace {
 
 template <class T>
-nlohmann::json optional_json(const std::optional<T>& v) {
-  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+synbench::Json optional_json(const std::optional<T>& v) {
+  return v ? synbench::Json(*v) : synbench::Json(nullptr);
 }
 
-nlohmann::json sweep_json(const db::Sweep& s, bool with_plan) {
-  nlohmann::json j = {{"id", s.id},
+synbench::Json sweep_json(const db::Sweep& s, bool with_plan) {
+  synbench::Json j = {{"id", s.id},
                       {"name", s.meta.name},
                       {"state", std::string(db::name(s.state))},
                       {"total_points", s.meta.total_points},
@@ -34,7 +34,7 @@ nlohmann::json sweep_json(const db::Sweep& s, bool with_plan) {
                       {"finished_at", optional_json(s.finished_at)},
                       {"last_error", optional_json(s.last_error)},
                       {"software_version", s.meta.software_version}};
-  if (with_plan) j["plan"] = nlohmann::json::parse(dump_json(s.meta.plan));
+  if (with_plan) j["plan"] = s.meta.plan;
   return j;
 }
 
@@ -136,7 +136,7 @@ constexpr std::size_t kViewerEstimatePoints = 100000;
 
 void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, Worker& worker,
                       std::filesystem::path db_path,
-                      nlohmann::ordered_json bench_config) {
+                      synbench::Json bench_config) {
   // The worker's connection is opened now, with the daemon's: opened on first use after the
   // file was deleted, it would make a new, empty database instead of noticing the loss.
   worker.post([db_path] {
@@ -157,7 +157,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 if (!s) return reply(db_error(s.error()));
                 if (s->state == db::SweepState::completed)
                   return reply(error_response(409, "invalid_state", "sweep " + std::to_string(*id) + " is already completed"));
-                auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(dump_json(s->meta.plan)));
+                auto parsed = bench::parse_sweep_plan(s->meta.plan);
                 if (!parsed.plan) return reply(error_response(500, "bad_plan", "the stored plan no longer parses"));
                 auto rows = db->points(*id);
                 if (!rows) return reply(db_error(rows.error()));
@@ -185,7 +185,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 if (!lock->claim(req.caller_id)) return locked(*lock);
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return *r;
-                auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
+                auto plan = bench::parse_sweep_plan(std::get<synbench::Json>(parsed));
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 db::SweepMeta meta;
                 meta.name = plan.plan->name.empty() ? "sweep" : plan.plan->name;
@@ -198,11 +198,11 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 if (!s) return db_error(s.error());
                 return json_response(201, sweep_json(*s, true));
               },
-              nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
+              synbench::Json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
   router.add({"GET", "/api/sweeps", Role::viewer, "Run history: every sweep in the store, by id.", [db](const Request&) {
                 auto list = db->list_sweeps();
                 if (!list) return db_error(list.error());
-                nlohmann::json out = nlohmann::json::array();
+                synbench::Json out = synbench::Json::array();
                 for (const auto& s : *list) out.push_back(sweep_json(s, false));
                 return json_response(200, out);
               }});
@@ -281,12 +281,12 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               })});
   router.add({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
               [](const Request&) {
-                nlohmann::json out = nlohmann::json::array();
+                synbench::Json out = synbench::Json::array();
                 const auto add = [&out](std::string_view name, const char* description, const bench::SweepPlan& p) {
                   out.push_back({{"name", std::string(name)},
                                  {"description", description},
-                                 {"plan", nlohmann::json::parse(dump_json(bench::to_json(p)))},
-                                 {"estimate", nlohmann::json::parse(dump_json(bench::to_json(bench::estimate(p))))}});
+                                 {"plan", bench::to_json(p)},
+                                 {"estimate", bench::to_json(bench::estimate(p))}});
                 };
                 add(bench::kThesisGridPreset,
                     "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, encoder/CAPWM",
@@ -300,18 +300,18 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               worker.offload([](const Request& req) {
                 auto parsed = parse_json_object(req.body);
                 if (auto* r = std::get_if<Response>(&parsed)) return *r;
-                auto plan = bench::parse_sweep_plan(std::get<nlohmann::json>(parsed));
+                auto plan = bench::parse_sweep_plan(std::get<synbench::Json>(parsed));
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 if (req.caller != Role::operator_ && size_bound(*plan.plan) > kViewerEstimatePoints)
                   return error_response(413, "too_large", "a viewer may estimate plans of at most " +
                                                               std::to_string(kViewerEstimatePoints) + " points");
                 const auto e = bench::estimate(*plan.plan);
-                nlohmann::json out = nlohmann::json::parse(dump_json(bench::to_json(e)));
+                synbench::Json out = bench::to_json(e);
                 out["duration_s"] = e.bench_time_s;
-                out["plan"] = nlohmann::json::parse(dump_json(bench::to_json(*plan.plan)));
+                out["plan"] = bench::to_json(*plan.plan);
                 return json_response(200, out);
               }),
-              nlohmann::json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
+              synbench::Json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
 }
 
 }  // namespace synbench::http

@@ -4,7 +4,7 @@
 // thread, as db/store.hpp asks.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "db/store.hpp"
 #include "server/http/api_routes.hpp"
@@ -19,6 +19,6 @@ namespace synbench::http {
 // there), off the io thread.
 void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, ControlLock& control, Worker& worker,
                       std::filesystem::path db_path,
-                      nlohmann::ordered_json bench_config);
+                      synbench::Json bench_config);
 
 }  // namespace synbench::http

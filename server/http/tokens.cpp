@@ -12,7 +12,7 @@
 #include <ctime>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "drivers/json_file.hpp"
 #include "server/http/sha256.hpp"
@@ -101,7 +101,7 @@ std::error_code TokenStore::load_locked() {
     if (read.error.find(": cannot open: ") != std::string::npos) return std::make_error_code(std::errc::permission_denied);
     return std::make_error_code(std::errc::invalid_argument);
   }
-  const nlohmann::json& doc = read.doc;
+  const synbench::Json& doc = read.doc;
   if (!doc.is_object() || !doc.contains("tokens") || !doc["tokens"].is_array())
     return std::make_error_code(std::errc::invalid_argument);
   std::vector<TokenEntry> entries;
@@ -131,7 +131,7 @@ std::string TokenStore::create(Role role, std::error_code& ec) {
   if (ec) return {};
   const std::string token = new_token();
   entries_.push_back({sha256_hex(token), role, utc_now()});
-  nlohmann::json doc = {{"tokens", nlohmann::json::array()}};
+  synbench::Json doc = {{"tokens", synbench::Json::array()}};
   for (const auto& e : entries_) doc["tokens"].push_back({{"sha256", e.sha256}, {"role", role_name(e.role)}, {"created", e.created}});
   std::error_code mk;
   if (file_.has_parent_path()) std::filesystem::create_directories(file_.parent_path(), mk);

@@ -21,40 +21,40 @@ double unix_ms_now() {
 }
 
 std::string telemetry_message(const BenchStatus& s, double sent_unix_ms) {
-  nlohmann::json j = {{"type", "telemetry"}, {"t_s", s.t_s}, {"sent_unix_ms", sent_unix_ms},
+  synbench::Json j = {{"type", "telemetry"}, {"t_s", s.t_s}, {"sent_unix_ms", sent_unix_ms},
                       {"enabled", s.enabled}, {"phase", phase_name(s.phase)}};
-  const nlohmann::json null;
-  j["speed_rpm"] = s.synrm ? nlohmann::json(s.synrm->speed_rpm) : null;
-  j["torque_Nm"] = s.load ? nlohmann::json(s.load->torque_Nm) : null;  // the load machine's braking torque
-  j["im_A"] = s.synrm ? nlohmann::json(s.synrm->im_A) : null;
-  j["id_A"] = s.synrm ? nlohmann::json(s.synrm->id_A) : null;
-  j["iq_A"] = s.synrm ? nlohmann::json(s.synrm->iq_A) : null;
-  j["udc_V"] = s.synrm ? nlohmann::json(s.synrm->udc_V) : null;
+  const synbench::Json null;
+  j["speed_rpm"] = s.synrm ? synbench::Json(s.synrm->speed_rpm) : null;
+  j["torque_Nm"] = s.load ? synbench::Json(s.load->torque_Nm) : null;  // the load machine's braking torque
+  j["im_A"] = s.synrm ? synbench::Json(s.synrm->im_A) : null;
+  j["id_A"] = s.synrm ? synbench::Json(s.synrm->id_A) : null;
+  j["iq_A"] = s.synrm ? synbench::Json(s.synrm->iq_A) : null;
+  j["udc_V"] = s.synrm ? synbench::Json(s.synrm->udc_V) : null;
   // The drive's own estimate of its output power, 1.5 (ud id + uq iq): not a DC-side measurement.
-  j["pac_W"] = s.synrm ? nlohmann::json(s.synrm->pac_W) : null;
-  j["temp_C"] = s.synrm && s.synrm->temp_C ? nlohmann::json(*s.synrm->temp_C) : null;
-  j["pos_err_deg"] = s.synrm && s.synrm->pos_err_deg ? nlohmann::json(*s.synrm->pos_err_deg) : null;
-  j["voltage_limited"] = s.synrm ? nlohmann::json(s.synrm->voltage_limited) : null;
-  j["lock_lost"] = s.synrm ? nlohmann::json(s.synrm->lock_lost) : null;
-  j["fault"] = s.synrm ? nlohmann::json(std::string(drivers::fault_name(s.synrm->fault))) : null;
+  j["pac_W"] = s.synrm ? synbench::Json(s.synrm->pac_W) : null;
+  j["temp_C"] = s.synrm && s.synrm->temp_C ? synbench::Json(*s.synrm->temp_C) : null;
+  j["pos_err_deg"] = s.synrm && s.synrm->pos_err_deg ? synbench::Json(*s.synrm->pos_err_deg) : null;
+  j["voltage_limited"] = s.synrm ? synbench::Json(s.synrm->voltage_limited) : null;
+  j["lock_lost"] = s.synrm ? synbench::Json(s.synrm->lock_lost) : null;
+  j["fault"] = s.synrm ? synbench::Json(std::string(drivers::fault_name(s.synrm->fault))) : null;
   return dump_json(j);
 }
 
-nlohmann::json sweep_json(const BenchStatus& s, std::optional<double> eta_s) {
-  const nlohmann::json null;
+synbench::Json sweep_json(const BenchStatus& s, std::optional<double> eta_s) {
+  const synbench::Json null;
   if (!s.sweep) return {{"type", "sweep"}, {"id", null}, {"state", null}, {"done", 0}, {"total", 0}, {"eta_s", null}};
   return {{"type", "sweep"},        {"id", s.sweep->id},       {"state", s.sweep->state},
-          {"done", s.sweep->done},  {"total", s.sweep->total}, {"eta_s", eta_s ? nlohmann::json(*eta_s) : null}};
+          {"done", s.sweep->done},  {"total", s.sweep->total}, {"eta_s", eta_s ? synbench::Json(*eta_s) : null}};
 }
 
 std::string state_message(const BenchStatus& s) {
-  nlohmann::json j = status_json(s);
+  synbench::Json j = status_json(s);
   j["type"] = "state";
   return dump_json(j);
 }
 
 std::string event_message(const BenchEvent& e) {
-  return dump_json(nlohmann::json{{"type", "event"}, {"seq", e.seq}, {"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
+  return dump_json(synbench::Json{{"type", "event"}, {"seq", e.seq}, {"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
 }
 
 WsHub::WsHub(boost::asio::io_context& io, BenchRuntime& bench, const Router& router, Authenticator auth, std::string version,

@@ -18,7 +18,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "server/http/api_routes.hpp"
 #include "server/http/router.hpp"
@@ -107,7 +107,7 @@ class WsHub : public std::enable_shared_from_this<WsHub> {
 // Push messages, exposed for tests. `sent_unix_ms` is the wall clock (ms since the epoch, with a
 // fraction) when the hub built the message: clients measure delivery latency against it.
 std::string telemetry_message(const BenchStatus& s, double sent_unix_ms);
-nlohmann::json sweep_json(const BenchStatus& s, std::optional<double> eta_s);
+synbench::Json sweep_json(const BenchStatus& s, std::optional<double> eta_s);
 std::string state_message(const BenchStatus& s);
 std::string event_message(const BenchEvent& e);
 double unix_ms_now();

@@ -35,7 +35,7 @@ void fail(beast::error_code ec, const char* what) {
 const std::set<std::string> kChannels = {"telemetry", "sweep", "events"};
 
 // The first field of `doc` not in `known`, as "<field>: unknown field (expected: ...)".
-std::optional<std::string> unknown_field(const nlohmann::json& doc, const std::set<std::string>& known) {
+std::optional<std::string> unknown_field(const synbench::Json& doc, const std::set<std::string>& known) {
   for (const auto& [k, v] : doc.items())
     if (!known.count(k)) {
       std::string list;
@@ -127,7 +127,7 @@ void WsSession::handle(const std::string& text) {
   // reason ("not valid UTF-8 at byte 3"), never an exception.
   drivers::JsonParsed parsed = drivers::parse_json_text(text);
   const std::string parse_error = parsed.error;
-  const nlohmann::json& doc = parsed.doc;
+  const synbench::Json& doc = parsed.doc;
   std::string op;
   if (parse_error.empty() && doc.is_object() && doc.contains("op") && doc["op"].is_string()) op = doc["op"].get<std::string>();
 
@@ -146,7 +146,7 @@ void WsSession::handle(const std::string& text) {
   bad_message("op: unknown op '" + op + "' (expected: subscribe, unsubscribe, request)");
 }
 
-void WsSession::handle_auth(const nlohmann::json& doc) {
+void WsSession::handle_auth(const synbench::Json& doc) {
   if (auto bad = unknown_field(doc, {"op", "token"})) return refuse(*bad);
   if (!doc.contains("token") || !doc["token"].is_string()) return refuse("token: required, a string");
   const std::string token = doc["token"].get<std::string>();
@@ -161,10 +161,10 @@ void WsSession::handle_auth(const nlohmann::json& doc) {
   token_ = token;
   if (slot_) slot_->trust(identity_->role == Role::operator_ ? Trust::operator_ : Trust::viewer);
   auth_timer_.cancel();
-  send(nlohmann::json{{"type", "hello"}, {"role", role_name(identity_->role)}, {"id", identity_->id}, {"version", hub_->version()}});
+  send(synbench::Json{{"type", "hello"}, {"role", role_name(identity_->role)}, {"id", identity_->id}, {"version", hub_->version()}});
 }
 
-void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
+void WsSession::handle_subscribe(const synbench::Json& doc, bool subscribe) {
   if (auto bad = unknown_field(doc, subscribe ? std::set<std::string>{"op", "channel", "rate_hz"} : std::set<std::string>{"op", "channel"}))
     return bad_message(*bad);
   if (!doc.contains("channel")) return bad_message("channel: required (telemetry, sweep or events)");
@@ -173,10 +173,10 @@ void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
   const std::string channel = doc["channel"].get<std::string>();
   if (!subscribe) {
     (channel == "telemetry" ? telemetry_ : channel == "sweep" ? sweep_ : events_) = false;
-    return send(nlohmann::json{{"type", "unsubscribed"}, {"channel", channel}});
+    return send(synbench::Json{{"type", "unsubscribed"}, {"channel", channel}});
   }
   const WsLimits& lim = hub_->limits();
-  nlohmann::json rate = nullptr;
+  synbench::Json rate = nullptr;
   if (channel == "telemetry") {
     double rate_hz = lim.default_rate_hz;
     if (doc.contains("rate_hz")) {
@@ -193,7 +193,7 @@ void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
   } else if (doc.contains("rate_hz")) {
     return bad_message("rate_hz: only the telemetry channel has a rate");
   }
-  send(nlohmann::json{{"type", "subscribed"}, {"channel", channel}, {"rate_hz", rate}});
+  send(synbench::Json{{"type", "subscribed"}, {"channel", channel}, {"rate_hz", rate}});
   if (channel == "sweep") {
     sweep_ = true;
     send(std::make_shared<const std::string>(hub_->sweep_message(hub_->bench().snapshot()->status)));
@@ -203,13 +203,13 @@ void WsSession::handle_subscribe(const nlohmann::json& doc, bool subscribe) {
   }
 }
 
-void WsSession::handle_request(const nlohmann::json& doc) {
+void WsSession::handle_request(const synbench::Json& doc) {
   if (auto bad = unknown_field(doc, {"op", "id", "method", "path", "body"})) return bad_message(*bad);
   if (!doc.contains("method") || !doc["method"].is_string() || doc["method"].get<std::string>().empty())
     return bad_message("method: required, an HTTP method such as \"POST\"");
   if (!doc.contains("path") || !doc["path"].is_string() || doc["path"].get<std::string>().rfind('/', 0) != 0)
     return bad_message("path: required, starting with / (such as \"/api/bench/status\")");
-  const nlohmann::json id = doc.contains("id") ? doc["id"] : nlohmann::json(nullptr);
+  const synbench::Json id = doc.contains("id") ? doc["id"] : synbench::Json(nullptr);
   std::string body;
   if (doc.contains("body")) body = dump_json(doc["body"]);
   // Through the REST router with this session's token: the same roles, lock and validation. A
@@ -220,12 +220,12 @@ void WsSession::handle_request(const nlohmann::json& doc) {
                                 });
 }
 
-void WsSession::reply(const nlohmann::json& id, const Response& r) {
+void WsSession::reply(const synbench::Json& id, const Response& r) {
   // A reply over the limit would overflow the send queue and drop the client: it is answered
   // with an error naming the way to get it in pieces instead.
   const std::size_t max = hub_->limits().max_reply_bytes;
   const auto too_large = [&](std::size_t bytes) {
-    send(nlohmann::json{{"type", "reply"}, {"id", id}, {"status", 413},
+    send(synbench::Json{{"type", "reply"}, {"id", id}, {"status", 413},
                         {"body", {{"error", {{"code", "reply_too_large"},
                                              {"message", "the reply is " + std::to_string(bytes) + " bytes, over the WebSocket's " +
                                                              std::to_string(max) + "-byte limit: ask for less (the points route "
@@ -233,15 +233,15 @@ void WsSession::reply(const nlohmann::json& id, const Response& r) {
   };
   if (r.body.size() > max) return too_large(r.body.size());
   try {
-    nlohmann::json reply_body = r.body;  // a text body (metrics, CSV) stays a string
+    synbench::Json reply_body = r.body;  // a text body (metrics, CSV) stays a string
     if (r.content_type.rfind("application/json", 0) == 0) {
       drivers::JsonParsed parsed = drivers::parse_json_text(r.body);
       if (parsed.ok()) reply_body = std::move(parsed.doc);
     }
-    nlohmann::json message{{"type", "reply"}, {"id", id}, {"status", r.status}, {"body", std::move(reply_body)}};
+    synbench::Json message{{"type", "reply"}, {"id", id}, {"status", r.status}, {"body", std::move(reply_body)}};
     if (!r.headers.empty()) {
       // Response headers a client may need (X-Total-Count of a page, Allow of a 405).
-      nlohmann::json headers = nlohmann::json::object();
+      synbench::Json headers = synbench::Json::object();
       for (const auto& [k, v] : r.headers) headers[k] = v;
       message["headers"] = std::move(headers);
     }
@@ -250,17 +250,17 @@ void WsSession::reply(const nlohmann::json& id, const Response& r) {
     send(std::move(text));
   } catch (const std::exception& e) {
     std::cerr << "synbench serve: websocket reply failed: " << drivers::escape_invalid_utf8(e.what()) << "\n";
-    send(nlohmann::json{{"type", "reply"}, {"id", id}, {"status", 500},
+    send(synbench::Json{{"type", "reply"}, {"id", id}, {"status", 500},
                         {"body", {{"error", {{"code", "internal"}, {"message", "the reply could not be built"}}}}}});
   }
 }
 
 void WsSession::bad_message(const std::string& message) {
-  send(nlohmann::json{{"type", "error"}, {"code", "bad_message"}, {"message", message}});
+  send(synbench::Json{{"type", "error"}, {"code", "bad_message"}, {"message", message}});
 }
 
 void WsSession::refuse(const std::string& message) {
-  send(nlohmann::json{{"type", "error"}, {"code", "unauthorized"}, {"message", message}});
+  send(synbench::Json{{"type", "error"}, {"code", "unauthorized"}, {"message", message}});
   closing_ = true;
   auth_timer_.cancel();
   close_after_write_ = true;
@@ -297,7 +297,7 @@ void WsSession::on_tick(const HubTick& tick) {
     for (const auto& e : tick.events) send(e);
 }
 
-void WsSession::send(const nlohmann::json& message) { send(std::make_shared<const std::string>(dump_json(message))); }
+void WsSession::send(const synbench::Json& message) { send(std::make_shared<const std::string>(dump_json(message))); }
 
 void WsSession::send(SharedText message) {
   if (dropped_ || closing_) return;

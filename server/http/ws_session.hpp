@@ -19,7 +19,7 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "server/http/connection_registry.hpp"
 #include "server/http/ws_hub.hpp"
@@ -44,16 +44,16 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_auth_timeout(boost::beast::error_code ec);
   void on_tick(const HubTick& tick);
   void handle(const std::string& text);
-  void handle_auth(const nlohmann::json& doc);
-  void handle_subscribe(const nlohmann::json& doc, bool subscribe);
-  void handle_request(const nlohmann::json& doc);
+  void handle_auth(const synbench::Json& doc);
+  void handle_subscribe(const synbench::Json& doc, bool subscribe);
+  void handle_request(const synbench::Json& doc);
   // Sends the router's answer to request `id`, on this session's strand.
-  void reply(const nlohmann::json& id, const Response& r);
+  void reply(const synbench::Json& id, const Response& r);
   void bad_message(const std::string& message);
   // An `unauthorized` error, then close 1008 once it is written.
   void refuse(const std::string& message);
   void send(SharedText message);
-  void send(const nlohmann::json& message);
+  void send(const synbench::Json& message);
   void do_write();
   void on_write(boost::beast::error_code ec, std::size_t bytes);
   // The planned close (after refuse()) once the queue is written.

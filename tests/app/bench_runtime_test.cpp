@@ -23,7 +23,7 @@ class TwinBackend final : public BenchBackend {
   TwinBackend() : twin_(emulator::TwinConfig{}) {}
   drivers::BenchDevices devices() override { return twin_.devices(); }
   drivers::Clock& clock() override { return twin_.clock(); }
-  nlohmann::json describe() const override { return nlohmann::json::array(); }
+  synbench::Json describe() const override { return synbench::Json::array(); }
   const BenchDescription& description() const override { return description_; }
 
  private:
@@ -119,7 +119,7 @@ class SlowReadsAfterDisable final : public BenchBackend {
     return d;
   }
   drivers::Clock& clock() override { return twin_.clock(); }
-  nlohmann::json describe() const override { return nlohmann::json::array(); }
+  synbench::Json describe() const override { return synbench::Json::array(); }
   const BenchDescription& description() const override { return description_; }
   std::atomic<double> slow_read_s{0.3};
   std::atomic<bool> disabled{false};
@@ -209,7 +209,7 @@ TEST(BenchRuntime, APlansStricterLimitsBindTheDaemonsSweep) {
   std::int64_t id = 0;
   bench::SweepPlan plan;
   {
-    auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(R"({"name": "strict", "window_s": 0.2,
+    auto parsed = bench::parse_sweep_plan(synbench::Json::parse(R"({"name": "strict", "window_s": 0.2,
         "dimensions": {"speed_rpm": [300], "load_Nm": [1.5], "angle_deg": [50]}, "limits": {"max_current_A": 0.5}})"));
     ASSERT_TRUE(parsed.plan) << (parsed.errors.empty() ? "" : parsed.errors[0].reason);
     plan = *parsed.plan;

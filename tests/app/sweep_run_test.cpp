@@ -34,7 +34,7 @@ TEST(SweepRun, ADatabaseDeletedDuringTheSweepFaultsItWithTheStoresMessage) {
   const auto dir = std::filesystem::temp_directory_path() / ("synbench_sweep_run_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto db_path = dir / "synbench.db";
-  auto parsed = bench::parse_sweep_plan(nlohmann::json::parse(R"({"name": "lost", "window_s": 0.2,
+  auto parsed = bench::parse_sweep_plan(synbench::Json::parse(R"({"name": "lost", "window_s": 0.2,
       "dimensions": {"speed_rpm": [300], "load_Nm": [0.5], "angle_deg": [45, 50, 55, 60]}})"));
   ASSERT_TRUE(parsed.plan) << (parsed.errors.empty() ? "" : parsed.errors[0].reason);
   auto opened = db::Store::open(db_path);

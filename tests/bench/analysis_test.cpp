@@ -5,7 +5,7 @@
 #include "bench/analysis.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cmath>
 
@@ -352,8 +352,8 @@ TEST(Analysis, EfficiencyMapAtTheMeAngle) {
   const auto j = to_json(a)["efficiency_map"]["entries"];
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[0]["estimator"], "encoder");
-  EXPECT_EQ(j[0]["speeds_rpm"], nlohmann::json::parse("[500.0, 900.0]"));
-  EXPECT_EQ(j[0]["loads_Nm"], nlohmann::json::parse("[1.0, 2.0]"));
+  EXPECT_EQ(j[0]["speeds_rpm"], synbench::Json::parse("[500.0, 900.0]"));
+  EXPECT_EQ(j[0]["loads_Nm"], synbench::Json::parse("[1.0, 2.0]"));
   EXPECT_NEAR(j[0]["efficiency"][0][1].get<double>(), 104.72 / 260, 1e-12);
   EXPECT_NEAR(j[0]["efficiency"][1][0].get<double>(), 94.25 / 250, 1e-12);
   EXPECT_TRUE(j[0]["efficiency"][1][1].is_null()) << "900 rpm, 2 N m was not measured";
@@ -392,7 +392,7 @@ TEST(Analysis, JsonIsSelfDescribingAndStable) {
   // No NaN sneaks into a document: an empty analysis is valid JSON with empty sections.
   const auto empty = to_json(analyze({}));
   EXPECT_EQ(empty["curves"]["entries"].size(), 0u);
-  EXPECT_TRUE(nlohmann::json::accept(empty.dump()));
+  EXPECT_TRUE(synbench::Json::accept(empty.dump()));
 }
 
 }  // namespace

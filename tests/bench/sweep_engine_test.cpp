@@ -4,7 +4,7 @@
 #include "bench/sweep_engine.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +34,7 @@ struct VectorSink : SweepSink {
 };
 
 SweepPlan plan_from(const char* json) {
-  auto r = parse_sweep_plan(nlohmann::json::parse(json));
+  auto r = parse_sweep_plan(synbench::Json::parse(json));
   EXPECT_TRUE(r.errors.empty()) << (r.errors.empty() ? "" : to_string(r.errors.front()));
   return *r.plan;
 }

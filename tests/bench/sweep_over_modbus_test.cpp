@@ -4,7 +4,7 @@
 // a real RS-485 line is. Every point must be measured; and when the link is really cut, the
 // supervisor must trip link_loss within its deadline.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -38,7 +38,7 @@ struct VectorSink : SweepSink {
 };
 
 SweepPlan plan_from(const char* json) {
-  auto r = parse_sweep_plan(nlohmann::json::parse(json));
+  auto r = parse_sweep_plan(synbench::Json::parse(json));
   EXPECT_TRUE(r.errors.empty()) << (r.errors.empty() ? "" : to_string(r.errors.front()));
   return *r.plan;
 }

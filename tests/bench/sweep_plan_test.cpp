@@ -4,7 +4,7 @@
 #include "bench/sweep_plan.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +19,7 @@
 namespace synbench::bench {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 using drivers::Estimator;
 using drivers::Pwm;
 

@@ -22,7 +22,7 @@ namespace synbench::bench {
 namespace {
 
 using drivers::DeviceKind;
-using nlohmann::json;
+using json = synbench::Json;
 namespace t = synbench::testing;
 
 TEST(UnknownFault, StopsTheBenchInOrderAndCarriesTheDevicesCode) {

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 #include <stdlib.h>
 
 #include "bench/point_record.hpp"

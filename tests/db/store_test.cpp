@@ -44,7 +44,7 @@ class StoreTest : public ::testing::Test {
 TEST_F(StoreTest, CreatesASweepWithItsMetadata) {
   SweepMeta meta;
   meta.name = "thesis grid, encoder";
-  meta.plan = nlohmann::ordered_json::parse(R"({"speeds_rpm":[500,1000],"loads_Nm":[0,1.5],"z":1,"a":2})");
+  meta.plan = synbench::Json::parse(R"({"speeds_rpm":[500,1000],"loads_Nm":[0,1.5],"z":1,"a":2})");
   meta.profiles = {{"synrm", {{"unit", 1}}}, {"pmsm", {{"unit", 2}}}};
   meta.bench_config = {{"transport", "twin"}};
   meta.total_points = 4;  // calibration left null

@@ -1,14 +1,14 @@
 // Tests of the bench cross-checks: devices whose registers collide on one link, the same
 // collision only when served on one endpoint, and one serial port named by two links.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "drivers/bench_check.hpp"
 
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 json config(const std::string& meter_link, int load_unit) {
   return json{{"links",

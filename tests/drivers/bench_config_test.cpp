@@ -1,6 +1,6 @@
 // Tests of bench configs: a valid one, and every rejection naming its JSON pointer.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -11,7 +11,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 json valid() {
   return json::parse(R"({

@@ -1,7 +1,7 @@
 // Tests of the default profiles (synbench's own firmware) and of the docs generated from them:
 // docs/register-map.md and the signal catalogue in docs/device-profile.md must match the code.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cstdlib>
 #include <fstream>
@@ -197,7 +197,7 @@ TEST(GeneratedDocs, DeviceProfileDocExampleIsValid) {
   const auto e = doc.find("```", b + fence.size());
   ASSERT_NE(e, std::string::npos);
   const ProfileParseResult r =
-      parse_device_profile(nlohmann::json::parse(doc.substr(b + fence.size(), e - b - fence.size())));
+      parse_device_profile(synbench::Json::parse(doc.substr(b + fence.size(), e - b - fence.size())));
   ASSERT_TRUE(r.profile) << describe(r.errors);
   EXPECT_EQ(r.profile->kind, DeviceKind::synrm_drive);
   EXPECT_EQ(r.profile->find("udc_V")->unit_id, 6);

@@ -4,7 +4,7 @@
 #include "drivers/error.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -14,7 +14,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 json default_doc(DeviceKind kind) {
   std::ifstream in(default_profile_path(kind));
@@ -49,8 +49,8 @@ const std::vector<InvalidCase> kInvalid = {
      "unknown register kind 'holdings'"},
     {"overlap_same_kind_and_unit", DeviceKind::vfc_meter,
      // counts_m occupies input 102-103; counts_g moved onto 103 collides with its low word.
-     [](json& d) { d["signals"]["counts_g"]["address"] = 103; }, "/signals/counts_m/address",
-     "overlaps 'counts_g' (input 103..104, unit id 3)"},
+     [](json& d) { d["signals"]["counts_g"]["address"] = 103; }, "/signals/counts_g/address",
+     "overlaps 'counts_m' (input 102..103, unit id 3)"},
     {"address_out_of_range", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["address"] = 65536; },
      "/signals/gate_s/address", "65536 is outside 0..65535"},
     {"negative_address", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["address"] = -1; },
@@ -147,8 +147,8 @@ const std::vector<InvalidCase> kInvalid = {
      [](json& d) { d["signals"]["gate_sequence"]["values"] = {{"first", 0}}; }, "/signals/gate_sequence/values",
      "gate_sequence is not an enumerated signal"},
     {"enum_value_twice", DeviceKind::vfc_meter,
-     [](json& d) { d["signals"]["gate_status"]["values"]["open"] = 2; }, "/signals/gate_status/values/open",
-     "also a code of 'done'"},
+     [](json& d) { d["signals"]["gate_status"]["values"]["open"] = 2; }, "/signals/gate_status/values/done",
+     "also a code of 'open'"},
     {"enum_on_a_float", DeviceKind::vfc_meter,
      [](json& d) {
        d["signals"]["gate_status"]["type"] = "f32";

@@ -4,7 +4,7 @@
 #include "drivers/frozen_watch.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <fstream>
 
@@ -15,7 +15,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 json host_window_synrm() {
   std::ifstream in(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / "synrm_host_window.json");

@@ -3,7 +3,7 @@
 #include "drivers/profile/window_schema.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <fstream>
 #include <string>
@@ -11,7 +11,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 json doc_of(const std::filesystem::path& p) {
   std::ifstream in(p);

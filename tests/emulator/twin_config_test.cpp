@@ -2,14 +2,14 @@
 #include "emulator/twin_config_schema.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <fstream>
 
 namespace synbench::emulator {
 namespace {
 
-std::string error_key(const nlohmann::json& doc) {
+std::string error_key(const synbench::Json& doc) {
   TwinConfig c;
   try {
     apply_json(c, doc);
@@ -21,27 +21,27 @@ std::string error_key(const nlohmann::json& doc) {
 
 TEST(TwinConfig, PartialOverlayChangesOnlyTheNamedKeys) {
   TwinConfig c;
-  apply_json(c, nlohmann::json::parse(R"({"synrm": {"rs_ohm": 10.5}, "vfc": {"motor": {"gain_error": 0.01}}})"));
+  apply_json(c, synbench::Json::parse(R"({"synrm": {"rs_ohm": 10.5}, "vfc": {"motor": {"gain_error": 0.01}}})"));
   EXPECT_DOUBLE_EQ(c.synrm.rs_ohm, 10.5);
   EXPECT_DOUBLE_EQ(c.vfc.motor.gain_error, 0.01);
   EXPECT_DOUBLE_EQ(c.synrm.flux_d.l0_H, 0.670);
 }
 
 TEST(TwinConfig, ErrorsNameTheKeyAndTheReason) {
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"synrm": {"rs_ohms": 1}})")), "synrm.rs_ohms | unknown key");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"synrm": {"rs_ohm": "9"}})")), "synrm.rs_ohm | must be a number");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"synrm": {"rs_ohm": -1}})")), "synrm.rs_ohm | -1 is outside (0, inf]");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"synrm": {"pole_pairs": 2.5}})")), "synrm.pole_pairs | must be an integer");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"firmware": {"pwm": "spwm"}})")),
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohms": 1}})")), "synrm.rs_ohms | unknown key");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": "9"}})")), "synrm.rs_ohm | must be a number");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": -1}})")), "synrm.rs_ohm | -1 is outside (0, inf]");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"pole_pairs": 2.5}})")), "synrm.pole_pairs | must be an integer");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"firmware": {"pwm": "spwm"}})")),
             "firmware.pwm | 'spwm' is not one of: capwm, aspwm");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"inverter": {"dead_time_compensation": 1}})")),
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"inverter": {"dead_time_compensation": 1}})")),
             "inverter.dead_time_compensation | must be true or false");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"dc_bus": {"brake_off_V": 445}})")),
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"dc_bus": {"brake_off_V": 445}})")),
             "dc_bus.brake_off_V | must be below dc_bus.brake_on_V");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"nonsense": {}})")), "nonsense | unknown key");
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"([1, 2])")), "(root) | must be a JSON object");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"nonsense": {}})")), "nonsense | unknown key");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"([1, 2])")), "(root) | must be a JSON object");
   // Comments (keys starting with '_') are allowed anywhere.
-  EXPECT_EQ(error_key(nlohmann::json::parse(R"({"_note": "x", "synrm": {"_assumed": ["b2"]}})")), "no error");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"_note": "x", "synrm": {"_assumed": ["b2"]}})")), "no error");
 }
 
 TEST(TwinConfig, DefaultsRoundTripThroughJsonAndMarkAssumedValues) {
@@ -58,7 +58,7 @@ TEST(TwinConfig, DefaultsRoundTripThroughJsonAndMarkAssumedValues) {
 TEST(TwinConfig, ShippedConfigFileEqualsTheDefaults) {
   std::ifstream in(std::string(SYNBENCH_SOURCE_DIR) + "/config/twin.json");
   ASSERT_TRUE(in) << "config/twin.json missing: regenerate with `synbench config --defaults`";
-  EXPECT_EQ(nlohmann::json::parse(in), to_json(TwinConfig{}))
+  EXPECT_EQ(synbench::Json::parse(in), to_json(TwinConfig{}))
       << "regenerate config/twin.json with `synbench config --defaults`";
 }
 

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   }
   // The thesis-grid preset with this one configuration; the dimensions given replace the
   // preset's, as in a plan file.
-  nlohmann::json doc = {{"name", "estimator chain"},
+  synbench::Json doc = {{"name", "estimator chain"},
                         {"preset", "thesis-grid"},
                         {"dimensions",
                          {{"configurations",

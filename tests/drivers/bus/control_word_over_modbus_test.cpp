@@ -13,7 +13,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 namespace t = synbench::testing;
 
 std::vector<DeviceProfile> vendor_bench() {

@@ -4,7 +4,7 @@
 // editing the default profiles, so the rest of the map (windows, telemetry) stays the firmware's.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include <fstream>
 #include <stdexcept>
@@ -14,12 +14,12 @@
 
 namespace synbench::testing {
 
-inline nlohmann::json default_profile_doc(drivers::DeviceKind kind) {
+inline synbench::Json default_profile_doc(drivers::DeviceKind kind) {
   std::ifstream in(drivers::default_profile_path(kind));
-  return nlohmann::json::parse(in);
+  return synbench::Json::parse(in);
 }
 
-inline drivers::DeviceProfile parse_or_throw(const nlohmann::json& doc) {
+inline drivers::DeviceProfile parse_or_throw(const synbench::Json& doc) {
   auto r = drivers::parse_device_profile(doc);
   if (!r.profile) {
     std::string why;
@@ -31,8 +31,8 @@ inline drivers::DeviceProfile parse_or_throw(const nlohmann::json& doc) {
 
 // The vendor's fault numbers (CiA 402 style); `with_watchdog` false leaves the watchdog's code
 // out, so a watchdog trip reads as a code the profile has no label for.
-inline nlohmann::json vendor_fault_codes(bool with_watchdog = true) {
-  nlohmann::json v = {{"none", 0},           {"overcurrent", {0x2310, 0x2311}}, {"overvoltage", 0x3210},
+inline synbench::Json vendor_fault_codes(bool with_watchdog = true) {
+  synbench::Json v = {{"none", 0},           {"overcurrent", {0x2310, 0x2311}}, {"overvoltage", 0x3210},
                       {"undervoltage", 0x3220}, {"overspeed", 0x8400},          {"overtemperature", 0x4210},
                       {"estop", 0x5441},       {"link_loss", 0x8100},          {"load_drive", 0x7300}};
   if (with_watchdog) v["watchdog"] = 0x8130;
@@ -41,7 +41,7 @@ inline nlohmann::json vendor_fault_codes(bool with_watchdog = true) {
 
 // Control word at holding 40 (enable bit 0, pwm_scheme bit 4, fault_reset bit 7), status word
 // at input 40 (state from mask 0x000B), vendor fault codes at input 41.
-inline nlohmann::json vendor_words(nlohmann::json doc, const nlohmann::json& reset, bool watchdog_code = true) {
+inline synbench::Json vendor_words(synbench::Json doc, const synbench::Json& reset, bool watchdog_code = true) {
   auto& s = doc["signals"];
   s["enable"] = {{"register", "holding"}, {"address", 40}, {"type", "u16"}, {"bit", 0}};
   s["pwm_scheme"] = {{"register", "holding"}, {"address", 40}, {"type", "u16"}, {"bit", 4},
@@ -55,13 +55,13 @@ inline nlohmann::json vendor_words(nlohmann::json doc, const nlohmann::json& res
   return doc;
 }
 
-inline nlohmann::json pulse_reset(int pulse_ms = 100) { return {{"mode", "pulse"}, {"pulse_ms", pulse_ms}}; }
-inline nlohmann::json level_reset() { return {{"mode", "level"}}; }
+inline synbench::Json pulse_reset(int pulse_ms = 100) { return {{"mode", "pulse"}, {"pulse_ms", pulse_ms}}; }
+inline synbench::Json level_reset() { return {{"mode", "level"}}; }
 
 // The SynRM drive as a vendor drive: its words, and `watchdog` in place of the heartbeat.
-inline nlohmann::json vendor_synrm(const nlohmann::json& reset, const nlohmann::json& watchdog,
+inline synbench::Json vendor_synrm(const synbench::Json& reset, const synbench::Json& watchdog,
                                    bool watchdog_code = true) {
-  nlohmann::json doc = vendor_words(default_profile_doc(drivers::DeviceKind::synrm_drive), reset, watchdog_code);
+  synbench::Json doc = vendor_words(default_profile_doc(drivers::DeviceKind::synrm_drive), reset, watchdog_code);
   doc["name"] = "vendor SynRM drive";
   if (!watchdog.is_null()) {
     doc["signals"].erase("heartbeat");
@@ -72,8 +72,8 @@ inline nlohmann::json vendor_synrm(const nlohmann::json& reset, const nlohmann::
 
 // The load drive with its fault reset as a coil of the given mode and `watchdog` (null: keep the
 // heartbeat counter).
-inline nlohmann::json vendor_load(const nlohmann::json& reset, const nlohmann::json& watchdog) {
-  nlohmann::json doc = default_profile_doc(drivers::DeviceKind::load_drive);
+inline synbench::Json vendor_load(const synbench::Json& reset, const synbench::Json& watchdog) {
+  synbench::Json doc = default_profile_doc(drivers::DeviceKind::load_drive);
   doc["name"] = "vendor load drive";
   doc["signals"]["fault_reset"]["reset"] = reset;
   if (!watchdog.is_null()) {
@@ -83,9 +83,9 @@ inline nlohmann::json vendor_load(const nlohmann::json& reset, const nlohmann::j
   return doc;
 }
 
-inline nlohmann::json any_write(const char* refresh, int period_ms = 250, int timeout_ms = 1000) {
+inline synbench::Json any_write(const char* refresh, int period_ms = 250, int timeout_ms = 1000) {
   return {{"kind", "any_write"}, {"refresh", refresh}, {"period_ms", period_ms}, {"timeout_ms", timeout_ms}};
 }
-inline nlohmann::json no_watchdog() { return {{"kind", "none"}}; }
+inline synbench::Json no_watchdog() { return {{"kind", "none"}}; }
 
 }  // namespace synbench::testing

@@ -125,7 +125,7 @@ TEST(Probe, ACodeWithoutALabelSaysSo) {
 // A masked signal's error is decoded through its mask, as the bench decodes it: the status word's
 // other bits do not leak into the code or the value the message names.
 TEST(Probe, AMaskedSignalsErrorNamesItsFieldNotTheWholeWord) {
-  nlohmann::json doc = synbench::testing::vendor_words(synbench::testing::default_profile_doc(DeviceKind::synrm_drive),
+  synbench::Json doc = synbench::testing::vendor_words(synbench::testing::default_profile_doc(DeviceKind::synrm_drive),
                                                        synbench::testing::pulse_reset());
   doc["signals"]["state"].erase("otherwise");
   doc["signals"]["state"]["values"].erase("stopping");

@@ -13,7 +13,7 @@
 namespace synbench::drivers {
 namespace {
 
-using nlohmann::json;
+using json = synbench::Json;
 
 using testing::FakeBus;
 

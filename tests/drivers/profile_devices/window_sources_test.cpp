@@ -6,7 +6,7 @@
 #include <cmath>
 #include <fstream>
 
-#include <nlohmann/json.hpp>
+#include "drivers/json.hpp"
 
 #include "drivers/error.hpp"
 #include "drivers/profile_devices/profile_bench.hpp"
@@ -223,7 +223,7 @@ TEST(ProfileBenchHostWindows, AMasterFrozenPastTheEndLeavesAGapAndTheDevicesCode
   FakeBus bus;
   ManualClock clock;
   std::ifstream in(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / "synrm_host_window.json");
-  nlohmann::json doc = nlohmann::json::parse(in);
+  synbench::Json doc = synbench::Json::parse(in);
   doc["signals"]["fault_code"]["values"].erase("watchdog");
   ProfileParseResult synrm = parse_device_profile(doc);
   ASSERT_TRUE(synrm.profile);

@@ -17,7 +17,7 @@ namespace synbench::emulator {
 namespace {
 
 using drivers::DeviceKind;
-using nlohmann::json;
+using json = synbench::Json;
 
 constexpr double kRunning = 1, kStopping = 2, kFaulted = 3;  // the bench's state codes
 

@@ -19,7 +19,7 @@ namespace {
 using drivers::DeviceKind;
 using drivers::DriveState;
 using drivers::Fault;
-using nlohmann::json;
+using json = synbench::Json;
 namespace t = synbench::testing;
 
 drivers::DeviceProfile meter() { return t::parse_or_throw(t::default_profile_doc(DeviceKind::vfc_meter)); }

@@ -61,7 +61,7 @@ std::vector<std::string> hostile_values() {
 }
 
 // Every value position of `doc` as a JSON pointer (the document itself excluded).
-void pointers(const nlohmann::json& doc, const std::string& at, std::vector<std::string>& out) {
+void pointers(const synbench::Json& doc, const std::string& at, std::vector<std::string>& out) {
   if (!at.empty()) out.push_back(at);
   if (doc.is_object())
     for (const auto& [k, v] : doc.items()) pointers(v, at + "/" + drivers::json_pointer_token(k), out);
@@ -86,12 +86,12 @@ class Mutator {
 
   // A value, key or the whole of a still-parsable document replaced by hostile text.
   std::string structured(const std::string& text) {
-    auto doc = nlohmann::json::parse(text, nullptr, false);
+    auto doc = synbench::Json::parse(text, nullptr, false);
     if (doc.is_discarded()) return bytes(text);
     std::vector<std::string> at;
     pointers(doc, "", at);
     if (at.empty()) return hostile();
-    const nlohmann::json::json_pointer p(at[pick(at.size())]);
+    const synbench::Json::json_pointer p(at[pick(at.size())]);
     const std::string marker = "@@synbench-fuzz@@";
     switch (pick(4)) {
       case 0: {  // a new key next to the value
@@ -101,7 +101,7 @@ class Mutator {
         break;
       }
       case 1:  // a duplicated subtree in place of a value
-        doc[p] = nlohmann::json::array({doc[p], doc[p]});
+        doc[p] = synbench::Json::array({doc[p], doc[p]});
         break;
       default: doc[p] = marker;
     }

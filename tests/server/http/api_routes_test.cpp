@@ -68,12 +68,12 @@ TEST_F(Api, TwinFollowsSpeedSetpointAndEstopLatches) {
   double speed = 0;
   for (int i = 0; i < 60 && std::abs(speed - 300) > 20; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    speed = nlohmann::json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body)["synrm"]["speed_rpm"];
+    speed = synbench::Json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body)["synrm"]["speed_rpm"];
   }
   EXPECT_NEAR(speed, 300, 20);
   const auto e = post("/api/bench/estop", "");
   ASSERT_EQ(e.status, 200);
-  const auto s = nlohmann::json::parse(e.body);
+  const auto s = synbench::Json::parse(e.body);
   EXPECT_EQ(s["supervisor"]["phase"], "estopped");
   EXPECT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 409);
   EXPECT_EQ(post("/api/bench/reset", "").status, 200);
@@ -85,9 +85,9 @@ TEST_F(Api, DisableTakesTheLoadOffBeforeTheSpeed) {
   ASSERT_EQ(post("/api/bench/setpoints", R"({"speed_rpm": 500, "load_Nm": 1.5, "angle_deg": 50})").status, 200);
   ASSERT_EQ(post("/api/bench/enable", R"({"enabled": true})").status, 200);
   const auto status = [&] {
-    return nlohmann::json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body);
+    return synbench::Json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body);
   };
-  nlohmann::json st;
+  synbench::Json st;
   for (int i = 0; i < 80; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     st = status();

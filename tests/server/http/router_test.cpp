@@ -25,7 +25,7 @@ Router make_router() {
   return r;
 }
 
-nlohmann::json body(const Response& r) { return nlohmann::json::parse(r.body); }
+synbench::Json body(const Response& r) { return synbench::Json::parse(r.body); }
 
 TEST(Router, MatchesPatternsAndDecodesQuery) {
   const Router r = make_router();

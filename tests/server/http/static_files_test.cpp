@@ -110,7 +110,7 @@ TEST(Origins, HttpOfEachAllowedHostAndTheExtraOnes) {
 
 TEST(HubMessages, NullsWhileTheLinkIsDown) {
   BenchStatus s;
-  const auto t = nlohmann::json::parse(telemetry_message(s, 12.5));
+  const auto t = synbench::Json::parse(telemetry_message(s, 12.5));
   EXPECT_EQ(t["type"], "telemetry");
   EXPECT_EQ(t["sent_unix_ms"], 12.5);
   EXPECT_TRUE(t["speed_rpm"].is_null());
@@ -120,10 +120,10 @@ TEST(HubMessages, NullsWhileTheLinkIsDown) {
   EXPECT_TRUE(sw["id"].is_null());
   s.sweep = app::SweepInfo{4, "running", 2, 10, ""};
   EXPECT_EQ(sweep_json(s, 8.0)["eta_s"], 8.0);
-  const auto e = nlohmann::json::parse(event_message(BenchEvent{1.5, "fault", "overcurrent", 7}));
+  const auto e = synbench::Json::parse(event_message(BenchEvent{1.5, "fault", "overcurrent", 7}));
   EXPECT_EQ(e["seq"], 7);
   EXPECT_EQ(e["kind"], "fault");
-  EXPECT_EQ(nlohmann::json::parse(state_message(s))["type"], "state");
+  EXPECT_EQ(synbench::Json::parse(state_message(s))["type"], "state");
 }
 
 }  // namespace
