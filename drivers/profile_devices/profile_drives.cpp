@@ -15,20 +15,20 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Which fields of a table a plan holds (the estimator results are read only with an estimator).
+constexpr auto every = [](const auto&) { return true; };
+constexpr auto is_estimate = [](const auto& f) { return f.estimate_bit != 0; };
+constexpr auto not_estimate = [](const auto& f) { return f.estimate_bit == 0; };
+
 // The signal names of a read plan: `lead` (a window's status and sequence, which
 // WindowChannel::read_results wants first), then the table's fields that `keep` accepts.
-template <class S, std::size_t N, class Keep>
-std::vector<std::string_view> names_of(const SignalField<S> (&table)[N], std::vector<std::string_view> lead, Keep keep) {
+template <class S, std::size_t N, class Keep = decltype(every)>
+std::vector<std::string_view> names_of(const SignalField<S> (&table)[N], std::vector<std::string_view> lead = {},
+                                       Keep keep = every) {
   for (const SignalField<S>& f : table)
     if (keep(f)) lead.push_back(f.signal);
   return lead;
 }
-template <class S, std::size_t N>
-std::vector<std::string_view> names_of(const SignalField<S> (&table)[N], std::vector<std::string_view> lead = {}) {
-  return names_of(table, std::move(lead), [](const SignalField<S>&) { return true; });
-}
-constexpr auto is_estimate = [](const auto& f) { return f.estimate_bit != 0; };
-constexpr auto not_estimate = [](const auto& f) { return f.estimate_bit == 0; };
 
 // The plan's value of `signal` (NaN when the plan has no such name or the profile lacks it).
 double value_of(const ReadPlan& plan, std::span<const double> values, std::string_view signal) {
@@ -38,9 +38,9 @@ double value_of(const ReadPlan& plan, std::span<const double> values, std::strin
 
 // Every field of `table` the plan holds, from the values read; the plan's own other names
 // (status, sequence) are left alone, fields it lacks read as absent.
-template <class S, std::size_t N, class Keep>
+template <class S, std::size_t N, class Keep = decltype(every)>
 void assign_read(S& out, const SignalField<S> (&table)[N], const ReadPlan& plan, std::span<const double> values,
-                 Keep keep) {
+                 Keep keep = every) {
   for (const SignalField<S>& f : table)
     if (keep(f)) assign(out, f.member, value_of(plan, values, f.signal));
 }
@@ -161,7 +161,7 @@ std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
   std::vector<double> v(telemetry_.size());
   if (auto ec = io().read(telemetry_, v)) return ec;
   SynrmTelemetry t;
-  assign_read(t, kSynrmTelemetrySignals, telemetry_, v, [](const auto&) { return true; });
+  assign_read(t, kSynrmTelemetrySignals, telemetry_, v);
   t.fault_code_raw = raw_code(t.fault, telemetry_.device_value(telemetry_.index("fault_code")));
   // The register reads 0 with the encoder and on the lock guard; a profile without it leaves the
   // field empty.
@@ -233,7 +233,7 @@ std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
   std::vector<double> v(telemetry_.size());
   if (auto ec = io().read(telemetry_, v)) return ec;
   LoadTelemetry t;
-  assign_read(t, kLoadTelemetrySignals, telemetry_, v, [](const auto&) { return true; });
+  assign_read(t, kLoadTelemetrySignals, telemetry_, v);
   t.fault_code_raw = raw_code(t.fault, telemetry_.device_value(telemetry_.index("fault_code")));
   out = t;
   return {};
@@ -249,7 +249,7 @@ std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
   } else {
     std::vector<double> v(window_.size());
     if (auto ec = window().read_results(window_, v)) return ec;
-    assign_read(w, kLoadWindowSignals, window_, v, [](const auto&) { return true; });
+    assign_read(w, kLoadWindowSignals, window_, v);
   }
   out = w;
   return {};
@@ -284,7 +284,7 @@ std::error_code ProfileMeter::read(MeterReading& out) {
   } else {
     std::vector<double> v(gate_.size());
     if (auto ec = window().read_results(gate_, v)) return ec;
-    assign_read(m, kMeterGateSignals, gate_, v, [](const auto&) { return true; });
+    assign_read(m, kMeterGateSignals, gate_, v);
   }
   out = m;
   return {};
