@@ -1,4 +1,5 @@
-// Typed devices over profile signals.
+// Typed devices over profile signals: reads planned, decoded and averaged through the device
+// structs' signal tables (drivers/device_signals.hpp), never by position.
 #include "drivers/profile_devices/profile_drives.hpp"
 
 #include <algorithm>

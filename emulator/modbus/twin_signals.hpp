@@ -1,13 +1,14 @@
 // The firmware side of the twin's register map: what each signal of the default profiles means
 // on the twin's drives and meter (the structs' signals through drivers/device_signals.hpp, the
-// control and status signals through a table of their own), plus what a drive does around its registers: the watchdog the
-// profile names (counter: the heartbeat must change within timeout_ms while a drive is enabled;
-// any_write: some write must arrive within it; else both drives stop in order and latch fault 6;
-// none: no timer), the fault reset (on the level, or with a pulse-reset profile only on a rising
-// edge, as a drive that wants a pulse does), and the measurement windows with their status
-// and sequence numbers. The three devices share one trigger, as on the thesis bench: the first
-// window start opens the twin's window on all of them, a start on another device while it is
-// open joins it (same length), and each participant's results are published when it closes.
+// control and status signals through a table of their own), plus what a drive does around its
+// registers: the watchdog the profile names (counter: the heartbeat must change within
+// timeout_ms while a drive is enabled; any_write: some write must arrive within it; else both
+// drives stop in order and latch fault 6; none: no timer), the fault reset (on the level, or
+// with a pulse-reset profile only on a rising edge, as a drive that wants a pulse does), and the
+// measurement windows with their status and sequence numbers. The three devices share one
+// trigger, as on the thesis bench: the first window start opens the twin's window on all of
+// them, a start on another device while it is open joins it (same length), and each
+// participant's results are published when it closes.
 #pragma once
 
 #include <array>
