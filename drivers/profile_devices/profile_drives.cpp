@@ -1,4 +1,5 @@
-// Typed devices over profile signals.
+// Typed devices over profile signals: reads planned, decoded and averaged through the device
+// structs' signal tables (drivers/device_signals.hpp), never by position.
 #include "drivers/profile_devices/profile_drives.hpp"
 
 #include <algorithm>
@@ -6,15 +7,61 @@
 #include <limits>
 #include <stdexcept>
 
+#include "drivers/device_signals.hpp"
 #include "drivers/error.hpp"
 #include "drivers/frozen_watch.hpp"
 
 namespace synbench::drivers {
 namespace {
 
-// NaN (signal absent from the profile) reads as `absent`.
-double or_(double v, double absent = 0.0) { return std::isnan(v) ? absent : v; }
-std::optional<double> opt(double v) { return std::isnan(v) ? std::nullopt : std::optional<double>(v); }
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Which fields of a table a plan holds (the estimator results are read only with an estimator).
+constexpr auto every = [](const auto&) { return true; };
+constexpr auto is_estimate = [](const auto& f) { return f.estimate_bit != 0; };
+constexpr auto not_estimate = [](const auto& f) { return f.estimate_bit == 0; };
+
+// The signal names of a read plan: `lead` (a window's status and sequence, which
+// WindowChannel::read_results wants first), then the table's fields that `keep` accepts.
+template <class S, std::size_t N, class Keep = decltype(every)>
+std::vector<std::string_view> names_of(const SignalField<S> (&table)[N], std::vector<std::string_view> lead = {},
+                                       Keep keep = every) {
+  for (const SignalField<S>& f : table)
+    if (keep(f)) lead.push_back(f.signal);
+  return lead;
+}
+
+// The plan's value of `signal` (NaN when the plan has no such name or the profile lacks it).
+double value_of(const ReadPlan& plan, std::span<const double> values, std::string_view signal) {
+  const std::size_t i = plan.index(signal);
+  return i < plan.size() ? values[i] : kNaN;
+}
+
+// Every field of `table` the plan holds, from the values read; the plan's own other names
+// (status, sequence) are left alone, fields it lacks read as absent.
+template <class S, std::size_t N, class Keep = decltype(every)>
+void assign_read(S& out, const SignalField<S> (&table)[N], const ReadPlan& plan, std::span<const double> values,
+                 Keep keep = every) {
+  for (const SignalField<S>& f : table)
+    if (keep(f)) assign(out, f.member, value_of(plan, values, f.signal));
+}
+
+// The mean over a host window of each table signal into its member.
+template <class S, std::size_t N>
+void assign_means(S& out, const SignalField<S> (&table)[N], const ReadPlan& plan, const HostWindow& h) {
+  for (const SignalField<S>& f : table) {
+    const std::size_t i = plan.index(f.signal);
+    assign(out, f.member, i < plan.size() ? h.mean(i) : kNaN);
+  }
+}
+
+// What every host-kept window reports of its own keeping.
+template <class W>
+void keep_by_host(W& w, const HostWindow& h) {
+  w.keeper = WindowKeeper::host;
+  w.samples = h.samples();
+  w.host = {h.period_s(), h.longest_gap_s()};
+}
 
 // The device's own code behind a fault the profile has no label for.
 std::optional<std::int64_t> raw_code(Fault f, double device_value) {
@@ -81,17 +128,9 @@ HostWindow* ProfileDevice::host_window_over(const ReadPlan& plan) {
 
 ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::synrm_drive), std::move(profile))),
-      telemetry_(this->profile(), {"state", "fault_code", "speed_rpm", "im_A", "id_A", "iq_A", "ud_V",
-                                   "uq_V", "udc_V", "pac_W", "temp_C", "voltage_limited", "pos_err_deg", "lock_lost"}),
-      window_(this->profile(),
-              {"window_status", "window_sequence", "window_samples", "window_fault_code", "window_s",
-               "window_speed_meas_rpm", "window_im_A", "window_id_A", "window_iq_A", "window_ud_V",
-               "window_uq_V", "window_udc_V", "window_temp_C", "window_voltage_limited_fraction",
-               "window_fallback_fraction", "window_lock_lost_fraction"}),
-      estimator_window_(this->profile(),
-                        {"window_pos_err_min_deg", "window_pos_err_mean_deg", "window_pos_err_max_deg",
-                         "window_speed_err_rpm", "window_ld_est_H", "window_lq_est_H",
-                         "window_rs_est_ohm", "window_estimates_present"}),
+      telemetry_(this->profile(), names_of(kSynrmTelemetrySignals)),
+      window_(this->profile(), names_of(kSynrmWindowSignals, {"window_status", "window_sequence"}, not_estimate)),
+      estimator_window_(this->profile(), names_of(kSynrmWindowSignals, {"window_estimates_present"}, is_estimate)),
       host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileSynrmDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
@@ -120,95 +159,59 @@ std::error_code ProfileSynrmDrive::set_estimator(Estimator estimator) {
 TelemetryResolution ProfileSynrmDrive::resolution() const { return telemetry_resolution(profile()); }
 
 std::error_code ProfileSynrmDrive::read(SynrmTelemetry& out) {
-  double v[14];
+  std::vector<double> v(telemetry_.size());
   if (auto ec = io().read(telemetry_, v)) return ec;
-  out.state = static_cast<DriveState>(static_cast<int>(v[0]));
-  out.fault = static_cast<Fault>(static_cast<int>(v[1]));
-  out.fault_code_raw = raw_code(out.fault, telemetry_.device_value(1));
-  out.speed_rpm = v[2];
-  out.im_A = or_(v[3]);
-  out.id_A = or_(v[4]);
-  out.iq_A = or_(v[5]);
-  out.ud_V = or_(v[6]);
-  out.uq_V = or_(v[7]);
-  out.udc_V = or_(v[8]);
-  out.pac_W = or_(v[9]);
-  out.temp_C = opt(v[10]);
-  out.voltage_limited = or_(v[11]) != 0;
+  SynrmTelemetry t;
+  assign_read(t, kSynrmTelemetrySignals, telemetry_, v);
+  t.fault_code_raw = raw_code(t.fault, telemetry_.device_value(telemetry_.index("fault_code")));
   // The register reads 0 with the encoder and on the lock guard; a profile without it leaves the
   // field empty.
-  out.lock_lost = or_(v[13]) != 0;
-  out.pos_err_deg = estimator_ != Estimator::encoder && !out.lock_lost ? opt(v[12]) : std::nullopt;
+  if (estimator_ == Estimator::encoder || t.lock_lost) t.pos_err_deg.reset();
+  out = t;
   return {};
 }
 
 std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   if (host_) return read_host_window(out);
-  double v[16];
+  std::vector<double> v(window_.size());
   if (auto ec = window().read_results(window_, v)) return ec;
   SynrmWindow w;
-  w.samples = static_cast<std::uint32_t>(v[2]);
-  w.fault = static_cast<Fault>(static_cast<int>(or_(v[3])));
-  w.fault_code_raw = raw_code(w.fault, window_.device_value(3));
-  w.window_s = v[4];
-  w.speed_meas_rpm = or_(v[5]);
-  w.im_A = or_(v[6]);
-  w.id_A = or_(v[7]);
-  w.iq_A = or_(v[8]);
-  w.ud_V = or_(v[9]);
-  w.uq_V = or_(v[10]);
-  w.udc_V = or_(v[11]);
-  w.temp_C = opt(v[12]);
-  w.voltage_limited_fraction = or_(v[13]);
-  w.fallback_fraction = or_(v[14]);
-  w.lock_lost_fraction = or_(v[15]);
+  assign_read(w, kSynrmWindowSignals, window_, v, not_estimate);
+  w.fault_code_raw = raw_code(w.fault, window_.device_value(window_.index("window_fault_code")));
   if (estimator_ != Estimator::encoder) {
     // Read after the sequence check: the next window cannot open before this bench starts it.
-    double e[8];
+    std::vector<double> e(estimator_window_.size());
     if (auto ec = io().read(estimator_window_, e)) return ec;
     // A register holds a number: the drive says which fields it has (a window wholly on the lock
     // guard has no errors; EEMF-CONST no estimates). Without the signal, all are present.
-    const unsigned present = std::isnan(e[7]) ? 15u : static_cast<unsigned>(e[7]);
-    const auto field = [present](double raw, unsigned bit) { return present & bit ? opt(raw) : std::nullopt; };
-    w.pos_err_min_deg = field(e[0], 1);
-    w.pos_err_mean_deg = field(e[1], 1);
-    w.pos_err_max_deg = field(e[2], 1);
-    w.speed_err_rpm = field(e[3], 1);
-    w.ld_est_H = field(e[4], 2);
-    w.lq_est_H = field(e[5], 4);
-    w.rs_est_ohm = field(e[6], 8);
+    const double bits = value_of(estimator_window_, e, "window_estimates_present");
+    const unsigned present = std::isnan(bits) ? ~0u : static_cast<unsigned>(bits);
+    for (const auto& f : kSynrmWindowSignals)
+      if (f.estimate_bit)
+        assign(w, f.member, present & f.estimate_bit ? value_of(estimator_window_, e, f.signal) : kNaN);
   }
   out = w;
   return {};
 }
 
-// The window the bench kept from the telemetry plan's samples (indices as in read()). The
-// filtered telemetry is all there is: no encoder-count speed (the mean of speed_rpm stands in),
-// no Ld/Lq/Rs estimates, position errors only when the drive reports pos_err_deg live.
+// The window the bench kept from the telemetry plan's samples. The filtered telemetry is all
+// there is: no encoder-count speed (kSynrmHostMeans), no Ld/Lq/Rs estimates, position errors
+// only when the drive reports pos_err_deg live.
 std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
   if (auto ec = host_->result()) return ec;
   const HostWindow& h = *host_;
   SynrmWindow w;
-  w.keeper = WindowKeeper::host;
-  w.samples = h.samples();
+  keep_by_host(w, h);
   w.window_s = h.span_s();
-  w.fault = static_cast<Fault>(static_cast<int>(h.first_nonzero(1)));
-  w.fault_code_raw = raw_code(w.fault, h.first_nonzero_device(1));
-  w.host = {h.period_s(), h.longest_gap_s()};
-  w.speed_meas_rpm = h.mean(2);
-  w.im_A = or_(h.mean(3));
-  w.id_A = or_(h.mean(4));
-  w.iq_A = or_(h.mean(5));
-  w.ud_V = or_(h.mean(6));
-  w.uq_V = or_(h.mean(7));
-  w.udc_V = or_(h.mean(8));
-  w.temp_C = opt(h.mean(10));
-  w.voltage_limited_fraction = or_(h.mean(11));
-  w.lock_lost_fraction = or_(h.mean(13));
-  if (estimator_ != Estimator::encoder && telemetry_.present(12)) {
-    w.pos_err_min_deg = h.min(12);
-    w.pos_err_mean_deg = h.mean(12);
-    w.pos_err_max_deg = h.max(12);
+  const std::size_t fault = telemetry_.index("fault_code");
+  assign(w, &SynrmWindow::fault, h.first_nonzero(fault));
+  w.fault_code_raw = raw_code(w.fault, h.first_nonzero_device(fault));
+  assign_means(w, kSynrmHostMeans, telemetry_, h);
+  const std::size_t pos_err = telemetry_.index("pos_err_deg");
+  if (estimator_ != Estimator::encoder && telemetry_.present(pos_err)) {
+    w.pos_err_min_deg = h.min(pos_err);
+    w.pos_err_mean_deg = h.mean(pos_err);
+    w.pos_err_max_deg = h.max(pos_err);
   }
   out = w;
   return {};
@@ -218,8 +221,8 @@ std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
 
 ProfileLoadDrive::ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::load_drive), std::move(profile))),
-      telemetry_(this->profile(), {"state", "fault_code", "torque_Nm", "iq_A"}),
-      window_(this->profile(), {"window_status", "window_sequence", "window_samples", "window_torque_Nm"}),
+      telemetry_(this->profile(), names_of(kLoadTelemetrySignals)),
+      window_(this->profile(), names_of(kLoadWindowSignals, {"window_status", "window_sequence"})),
       host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileLoadDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
@@ -228,32 +231,28 @@ std::error_code ProfileLoadDrive::set_torque_Nm(double v) { return io().write("t
 std::error_code ProfileLoadDrive::reset_fault() { return pulse_fault_reset(); }
 
 std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
-  double v[4];
+  std::vector<double> v(telemetry_.size());
   if (auto ec = io().read(telemetry_, v)) return ec;
-  out.state = static_cast<DriveState>(static_cast<int>(v[0]));
-  out.fault = static_cast<Fault>(static_cast<int>(v[1]));
-  out.fault_code_raw = raw_code(out.fault, telemetry_.device_value(1));
-  out.torque_Nm = v[2];
-  out.iq_A = or_(v[3]);
+  LoadTelemetry t;
+  assign_read(t, kLoadTelemetrySignals, telemetry_, v);
+  t.fault_code_raw = raw_code(t.fault, telemetry_.device_value(telemetry_.index("fault_code")));
+  out = t;
   return {};
 }
 
 std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
+  LoadWindow w;
   if (host_) {
     if (auto ec = host_->result()) return ec;
-    LoadWindow w;
-    w.keeper = WindowKeeper::host;
-    w.samples = host_->samples();
-    w.torque_Nm = host_->mean(2);
+    keep_by_host(w, *host_);
     w.window_s = host_->span_s();
-    w.host = {host_->period_s(), host_->longest_gap_s()};
-    out = w;
-    return {};
+    assign_means(w, kLoadHostMeans, telemetry_, *host_);
+  } else {
+    std::vector<double> v(window_.size());
+    if (auto ec = window().read_results(window_, v)) return ec;
+    assign_read(w, kLoadWindowSignals, window_, v);
   }
-  double v[4];
-  if (auto ec = window().read_results(window_, v)) return ec;
-  out.samples = static_cast<std::uint32_t>(or_(v[2]));
-  out.torque_Nm = or_(v[3]);
+  out = w;
   return {};
 }
 
@@ -261,8 +260,8 @@ std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
 
 ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::vfc_meter), std::move(profile))),
-      gate_(this->profile(), {"gate_status", "gate_sequence", "counts_m", "counts_g", "gate_s", "idcm_A", "idcg_A"}),
-      power_(this->profile(), {"pdcm_W", "pdcg_W"}) {
+      gate_(this->profile(), names_of(kMeterGateSignals, {"gate_status", "gate_sequence"})),
+      power_(this->profile(), names_of(kMeterPowerMeans)) {
   switch (this->profile().meter) {
     case MeterKind::gate: break;
     case MeterKind::totalizer: {
@@ -277,25 +276,18 @@ ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
 
 std::error_code ProfileMeter::read(MeterReading& out) {
   if (totalizer_) return totalizer_->read(out);
+  MeterReading m;
   if (host_) {
     if (auto ec = host_->result()) return ec;
-    MeterReading m;
-    m.keeper = WindowKeeper::host;
-    m.samples = host_->samples();
+    keep_by_host(m, *host_);
     m.gate_s = host_->span_s();
-    m.pdcm_W = host_->mean(0);
-    m.pdcg_W = host_->mean(1);
-    m.host = {host_->period_s(), host_->longest_gap_s()};
-    out = m;
-    return {};
+    assign_means(m, kMeterPowerMeans, power_, *host_);
+  } else {
+    std::vector<double> v(gate_.size());
+    if (auto ec = window().read_results(gate_, v)) return ec;
+    assign_read(m, kMeterGateSignals, gate_, v);
   }
-  double v[7];
-  if (auto ec = window().read_results(gate_, v)) return ec;
-  out.counts_m = static_cast<std::uint64_t>(or_(v[2]));
-  out.counts_g = static_cast<std::uint64_t>(or_(v[3]));
-  out.gate_s = or_(v[4]);
-  out.idcm_A = or_(v[5]);
-  out.idcg_A = or_(v[6]);
+  out = m;
   return {};
 }
 

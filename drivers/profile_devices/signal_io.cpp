@@ -21,8 +21,13 @@ ReadPlan::ReadPlan(const DeviceProfile& profile, std::span<const std::string_vie
   plan(profile, names);
 }
 
+std::size_t ReadPlan::index(std::string_view signal) const {
+  return static_cast<std::size_t>(std::find(names_.begin(), names_.end(), signal) - names_.begin());
+}
+
 void ReadPlan::plan(const DeviceProfile& profile, std::span<const std::string_view> names) {
   slots_.resize(names.size());
+  names_.assign(names.begin(), names.end());
   std::vector<std::size_t> order;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const ProfileSignal* s = profile.find(names[i]);

@@ -31,7 +31,10 @@ class ReadPlan {
   std::size_t size() const { return slots_.size(); }
   std::size_t requests() const { return requests_.size(); }
   // Whether the profile maps the i-th name.
-  bool present(std::size_t i) const { return slots_[i].signal != nullptr; }
+  bool present(std::size_t i) const { return i < slots_.size() && slots_[i].signal != nullptr; }
+  bool present(std::string_view signal) const { return present(index(signal)); }
+  // The position of `signal` among the names the plan was made of (size() when not among them).
+  std::size_t index(std::string_view signal) const;
   // The device's own number of the i-th signal at the last successful read of this plan, before
   // its enumerated label (NaN when absent or never read): the raw code of an unknown fault.
   double device_value(std::size_t i) const {
@@ -56,6 +59,7 @@ class ReadPlan {
 
   std::vector<Request> requests_;
   std::vector<Slot> slots_;
+  std::vector<std::string> names_;
   std::size_t words_ = 0;  // buffer sizes
   mutable std::vector<double> device_values_;  // of the last successful read
 };

@@ -2,9 +2,11 @@
 #include "emulator/modbus/twin_signals.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
 
+#include "drivers/device_signals.hpp"
 #include "drivers/error.hpp"
 
 namespace synbench::emulator {
@@ -17,11 +19,27 @@ namespace {
 // How often (in control periods) the watchdogs and the window are checked: 1 ms.
 constexpr std::int64_t kCheckSteps = 10;
 
-double code(DriveState s) { return static_cast<double>(static_cast<int>(s)); }
-double code(drivers::Fault f) { return static_cast<double>(static_cast<int>(f)); }
-double or0(const std::optional<double>& v) { return v.value_or(0.0); }
+constexpr unsigned bit(DeviceKind k) { return 1u << static_cast<unsigned>(k); }
+constexpr unsigned kSynrm = bit(DeviceKind::synrm_drive), kLoad = bit(DeviceKind::load_drive),
+                   kMeter = bit(DeviceKind::vfc_meter), kDrives = kSynrm | kLoad;
+
+// A struct member's value as a register shows it: an empty optional reads 0.
+template <class S, std::size_t N>
+std::optional<double> field(const S& in, const drivers::SignalField<S> (&table)[N], std::string_view signal) {
+  if (const auto* f = drivers::find_field(table, signal)) return drivers::number(in, f->member).value_or(0.0);
+  return std::nullopt;
+}
 
 }  // namespace
+
+// A signal that is no struct's member: a command's last accepted value, the watchdog's
+// heartbeat, the window's length, start, status and sequence, the meter's calibration.
+struct TwinSignals::Control {
+  unsigned devices;  // bit(kind) of each device that has it
+  std::string_view signal;
+  double (*read)(const TwinSignals&, DeviceKind);
+  std::error_code (*write)(TwinSignals&, DeviceKind, double);  // null: read only
+};
 
 TwinSignals::TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& profiles)
     : twin_(twin),
@@ -34,7 +52,108 @@ TwinSignals::TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& 
     if (p.watchdog.kind != drivers::WatchdogKind::none) d.timeout_s = p.watchdog.timeout_ms / 1000.0;
     if (const drivers::ProfileSignal* r = p.find("fault_reset"))
       d.reset_on_edge = r->reset.mode == drivers::FaultResetMode::Mode::pulse;
+    for (const drivers::ProfileSignal& s : p.signals)
+      if (!value(p.kind, s))
+        throw std::invalid_argument(std::string(drivers::name(p.kind)) + " profile '" + p.name + "': signal " +
+                                    s.name + ": the twin has no value for it");
   }
+}
+
+const TwinSignals::Control* TwinSignals::find_control(DeviceKind device, std::string_view signal) {
+  using T = TwinSignals;
+  using K = DeviceKind;
+  const auto enabled = [](const T& t, K k) -> double {
+    const DriveState s = k == K::synrm_drive ? t.twin_.synrm_drive().state() : t.twin_.load_drive().telemetry().state;
+    return drivers::running(s) ? 1 : 0;
+  };
+  const auto enable = [](T& t, K k, double v) {
+    const auto ec = k == K::synrm_drive ? t.twin_.synrm_drive().enable(v != 0) : t.twin_.load_drive().enable(v != 0);
+    if (!ec && v != 0) t.dev_[index(k)].heartbeat_change_s = t.twin_.time_s();  // the watchdog counts from the enable
+    return ec;
+  };
+  const auto reset_level = [](const T& t, K k) { return t.dev_[index(k)].reset_level; };
+  const auto reset = [](T& t, K k, double v) {
+    if (!t.reset_requested(t.dev_[index(k)], v)) return std::error_code{};
+    return k == K::synrm_drive ? t.twin_.synrm_drive().reset_fault() : t.twin_.load_drive().reset_fault();
+  };
+  const auto heartbeat = [](const T& t, K k) { return t.dev_[index(k)].heartbeat; };
+  const auto beat = [](T& t, K k, double v) {
+    Device& d = t.dev_[index(k)];
+    if (v != d.heartbeat) d.heartbeat_change_s = t.twin_.time_s();
+    d.heartbeat = v;
+    return std::error_code{};
+  };
+  const auto length = [](const T& t, K k) { return t.dev_[index(k)].window_length_ms; };
+  const auto set_length = [](T& t, K k, double v) {
+    if (!(v > 0)) return make_error_code(errc::invalid_argument);
+    t.dev_[index(k)].window_length_ms = v;
+    return std::error_code{};
+  };
+  // A start reads 0: the device clears it as it acts (RegisterServer never asks).
+  const auto zero = [](const T&, K) { return 0.0; };
+  const auto start = [](T& t, K k, double v) { return v != 0 ? t.start_window(k) : std::error_code{}; };
+  const auto status = [](const T& t, K k) -> double { return t.dev_[index(k)].window.status; };
+  const auto sequence = [](const T& t, K k) -> double { return t.dev_[index(k)].window.sequence; };
+  static const Control kControls[] = {
+      {kDrives, "enable", enabled, enable},
+      {kDrives, "fault_reset", reset_level, reset},
+      {kDrives, "heartbeat", heartbeat, beat},
+      {kDrives, "window_length_ms", length, set_length},
+      {kMeter, "gate_length_ms", length, set_length},
+      {kDrives, "window_start", zero, start},
+      {kMeter, "gate_start", zero, start},
+      {kDrives, "window_status", status, nullptr},
+      {kMeter, "gate_status", status, nullptr},
+      {kDrives, "window_sequence", sequence, nullptr},
+      {kMeter, "gate_sequence", sequence, nullptr},
+      {kSynrm, "speed_setpoint_rpm", [](const T& t, K) { return t.speed_set_rpm_; },
+       [](T& t, K, double v) {
+         const auto ec = t.twin_.synrm_drive().set_speed_rpm(v);
+         if (!ec) t.speed_set_rpm_ = v;
+         return ec;
+       }},
+      {kSynrm, "angle_setpoint_deg", [](const T& t, K) { return t.angle_set_deg_; },
+       [](T& t, K, double v) {
+         const auto ec = t.twin_.synrm_drive().set_angle_deg(v);
+         if (!ec) t.angle_set_deg_ = v;
+         return ec;
+       }},
+      {kSynrm, "pwm_scheme", [](const T& t, K) { return static_cast<double>(static_cast<int>(t.twin_.synrm_drive().pwm())); },
+       [](T& t, K, double v) { return t.twin_.synrm_drive().set_pwm(static_cast<drivers::Pwm>(static_cast<int>(v))); }},
+      {kSynrm, "estimator", [](const T& t, K) { return static_cast<double>(static_cast<int>(t.estimator_)); },
+       [](T& t, K, double v) {
+         const auto e = static_cast<drivers::Estimator>(static_cast<int>(v));
+         const auto ec = t.twin_.synrm_drive().set_estimator(e);
+         if (!ec) t.estimator_ = e;
+         return ec;
+       }},
+      {kSynrm, "window_estimates_present",
+       [](const T& t, K) {
+         return static_cast<double>(drivers::estimates_present(t.fixed_ ? t.fixed_->synrm_window : t.windows_.synrm_window));
+       },
+       nullptr},
+      {kLoad, "torque_setpoint_Nm", [](const T& t, K) { return t.torque_set_Nm_; },
+       [](T& t, K, double v) {
+         const auto ec = t.twin_.load_drive().set_torque_Nm(v);
+         if (!ec) t.torque_set_Nm_ = v;
+         return ec;
+       }},
+      // The meter turns counts into currents with these (close_window).
+      {kMeter, "f0_Hz", [](const T& t, K) { return t.f0_Hz_; },
+       [](T& t, K, double v) {
+         t.f0_Hz_ = v;
+         return std::error_code{};
+       }},
+      {kMeter, "kf_Hz_per_A", [](const T& t, K) { return t.kf_Hz_per_A_; },
+       [](T& t, K, double v) {
+         if (v == 0) return make_error_code(errc::invalid_argument);
+         t.kf_Hz_per_A_ = v;
+         return std::error_code{};
+       }},
+  };
+  for (const Control& c : kControls)
+    if ((c.devices & bit(device)) && c.signal == signal) return &c;
+  return nullptr;
 }
 
 void TwinSignals::accepted_write(DeviceKind device) {
@@ -56,108 +175,35 @@ bool TwinSignals::drive_enabled(DeviceKind k) const {
   return false;
 }
 
-double TwinSignals::synrm_value(const std::string& n) const {
-  auto& fw = twin_.synrm_drive();
-  const Device& d = dev_[index(DeviceKind::synrm_drive)];
-  if (n == "enable") return fw.state() == DriveState::running || fw.state() == DriveState::stopping;
-  if (n == "heartbeat") return d.heartbeat;
-  if (n == "fault_reset") return d.reset_level;
-  if (n == "window_length_ms") return d.window_length_ms;
-  if (n == "speed_setpoint_rpm") return speed_set_rpm_;
-  if (n == "angle_setpoint_deg") return angle_set_deg_;
-  if (n == "pwm_scheme") return static_cast<double>(static_cast<int>(fw.pwm()));
-  if (n == "estimator") return static_cast<double>(static_cast<int>(estimator_));
-  if (n == "window_status") return d.window.status;
-  if (n == "window_sequence") return d.window.sequence;
-  const drivers::SynrmWindow& w = synrm_window_;
-  if (n.rfind("window_", 0) == 0) {
-    if (n == "window_samples") return w.samples;
-    if (n == "window_fault_code") return code(w.fault);
-    if (n == "window_s") return w.window_s;
-    if (n == "window_speed_meas_rpm") return w.speed_meas_rpm;
-    if (n == "window_im_A") return w.im_A;
-    if (n == "window_id_A") return w.id_A;
-    if (n == "window_iq_A") return w.iq_A;
-    if (n == "window_ud_V") return w.ud_V;
-    if (n == "window_uq_V") return w.uq_V;
-    if (n == "window_udc_V") return w.udc_V;
-    if (n == "window_temp_C") return or0(w.temp_C);
-    if (n == "window_voltage_limited_fraction") return w.voltage_limited_fraction;
-    if (n == "window_pos_err_min_deg") return or0(w.pos_err_min_deg);
-    if (n == "window_pos_err_mean_deg") return or0(w.pos_err_mean_deg);
-    if (n == "window_pos_err_max_deg") return or0(w.pos_err_max_deg);
-    if (n == "window_speed_err_rpm") return or0(w.speed_err_rpm);
-    if (n == "window_ld_est_H") return or0(w.ld_est_H);
-    if (n == "window_lq_est_H") return or0(w.lq_est_H);
-    if (n == "window_rs_est_ohm") return or0(w.rs_est_ohm);
-    if (n == "window_fallback_fraction") return w.fallback_fraction;
-    if (n == "window_lock_lost_fraction") return w.lock_lost_fraction;
-    if (n == "window_estimates_present")
-      return (w.pos_err_mean_deg ? 1 : 0) + (w.ld_est_H ? 2 : 0) + (w.lq_est_H ? 4 : 0) + (w.rs_est_ohm ? 8 : 0);
-    return 0;
+drivers::SynrmTelemetry TwinSignals::synrm_telemetry() const {
+  return fixed_ ? fixed_->synrm : twin_.synrm_drive().telemetry();
+}
+
+drivers::LoadTelemetry TwinSignals::load_telemetry() const {
+  return fixed_ ? fixed_->load : twin_.load_drive().telemetry();
+}
+
+std::optional<double> TwinSignals::value(DeviceKind device, const drivers::ProfileSignal& s) const {
+  if (const Control* c = find_control(device, s.name)) return c->read(*this, device);
+  const Served& w = fixed_ ? *fixed_ : windows_;
+  switch (device) {
+    case DeviceKind::synrm_drive:
+      if (drivers::find_field(drivers::kSynrmTelemetrySignals, s.name))
+        return field(synrm_telemetry(), drivers::kSynrmTelemetrySignals, s.name);
+      return field(w.synrm_window, drivers::kSynrmWindowSignals, s.name);
+    case DeviceKind::load_drive:
+      if (drivers::find_field(drivers::kLoadTelemetrySignals, s.name))
+        return field(load_telemetry(), drivers::kLoadTelemetrySignals, s.name);
+      return field(w.load_window, drivers::kLoadWindowSignals, s.name);
+    case DeviceKind::vfc_meter:
+      if (const auto v = instruments_.value(twin_, s)) return v;
+      return field(w.meter_window, drivers::kMeterGateSignals, s.name);
   }
-  const drivers::SynrmTelemetry t = fw.telemetry();
-  if (n == "state") return code(t.state);
-  if (n == "fault_code") return code(t.fault);
-  if (n == "speed_rpm") return t.speed_rpm;
-  if (n == "im_A") return t.im_A;
-  if (n == "id_A") return t.id_A;
-  if (n == "iq_A") return t.iq_A;
-  if (n == "ud_V") return t.ud_V;
-  if (n == "uq_V") return t.uq_V;
-  if (n == "udc_V") return t.udc_V;
-  if (n == "pac_W") return t.pac_W;
-  if (n == "temp_C") return or0(t.temp_C);
-  if (n == "voltage_limited") return t.voltage_limited ? 1 : 0;
-  if (n == "pos_err_deg") return or0(t.pos_err_deg);
-  if (n == "lock_lost") return t.lock_lost ? 1 : 0;
-  return 0;
-}
-
-double TwinSignals::load_value(const std::string& n) const {
-  const Device& d = dev_[index(DeviceKind::load_drive)];
-  const drivers::LoadTelemetry t = twin_.load_drive().telemetry();
-  if (n == "enable") return t.state == DriveState::running || t.state == DriveState::stopping;
-  if (n == "heartbeat") return d.heartbeat;
-  if (n == "fault_reset") return d.reset_level;
-  if (n == "window_length_ms") return d.window_length_ms;
-  if (n == "torque_setpoint_Nm") return torque_set_Nm_;
-  if (n == "state") return code(t.state);
-  if (n == "fault_code") return code(t.fault);
-  if (n == "torque_Nm") return t.torque_Nm;
-  if (n == "iq_A") return t.iq_A;
-  if (n == "window_status") return d.window.status;
-  if (n == "window_sequence") return d.window.sequence;
-  if (n == "window_samples") return load_window_.samples;
-  if (n == "window_torque_Nm") return load_window_.torque_Nm;
-  return 0;
-}
-
-double TwinSignals::meter_value(const std::string& n) const {
-  const Device& d = dev_[index(DeviceKind::vfc_meter)];
-  if (n == "gate_length_ms") return d.window_length_ms;
-  if (n == "f0_Hz") return f0_Hz_;
-  if (n == "kf_Hz_per_A") return kf_Hz_per_A_;
-  if (n == "gate_status") return d.window.status;
-  if (n == "gate_sequence") return d.window.sequence;
-  const drivers::MeterReading& m = meter_window_;
-  if (n == "counts_m") return static_cast<double>(m.counts_m);
-  if (n == "counts_g") return static_cast<double>(m.counts_g);
-  if (n == "gate_s") return m.gate_s;
-  if (n == "idcm_A") return m.idcm_A;
-  if (n == "idcg_A") return m.idcg_A;
-  return 0;
+  return std::nullopt;
 }
 
 double TwinSignals::read_signal(DeviceKind device, const drivers::ProfileSignal& s) {
-  switch (device) {
-    case DeviceKind::synrm_drive: return synrm_value(s.name);
-    case DeviceKind::load_drive: return load_value(s.name);
-    case DeviceKind::vfc_meter:
-      if (const auto v = instruments_.value(twin_, s)) return *v;
-      return meter_value(s.name);
-  }
-  return 0;
+  return value(device, s).value_or(0.0);  // the constructor refused a profile with a signal it lacks
 }
 
 std::error_code TwinSignals::start_window(DeviceKind k) {
@@ -181,15 +227,16 @@ void TwinSignals::close_window() {
     Device& d = dev_[i];
     if (!d.in_window) continue;
     switch (static_cast<DeviceKind>(i)) {
-      case DeviceKind::synrm_drive: synrm_window_ = twin_.synrm_drive().window_result(); break;
-      case DeviceKind::load_drive: load_window_ = twin_.load_drive().window_result(); break;
+      case DeviceKind::synrm_drive: windows_.synrm_window = twin_.synrm_drive().window_result(); break;
+      case DeviceKind::load_drive: windows_.load_window = twin_.load_drive().window_result(); break;
       case DeviceKind::vfc_meter: {
-        meter_window_ = twin_.meter_reading();
+        drivers::MeterReading& m = windows_.meter_window;
+        m = twin_.meter_reading();
         // The meter turns counts into currents with its own calibration registers.
-        const double g = meter_window_.gate_s;
+        const double g = m.gate_s;
         if (g > 0) {
-          meter_window_.idcm_A = (static_cast<double>(meter_window_.counts_m) / g - f0_Hz_) / kf_Hz_per_A_;
-          meter_window_.idcg_A = (static_cast<double>(meter_window_.counts_g) / g - f0_Hz_) / kf_Hz_per_A_;
+          m.idcm_A = (static_cast<double>(m.counts_m) / g - f0_Hz_) / kf_Hz_per_A_;
+          m.idcg_A = (static_cast<double>(m.counts_g) / g - f0_Hz_) / kf_Hz_per_A_;
         }
         break;
       }
@@ -201,75 +248,8 @@ void TwinSignals::close_window() {
 }
 
 std::error_code TwinSignals::write_signal(DeviceKind device, const drivers::ProfileSignal& s, double v) {
-  const std::string& n = s.name;
-  Device& d = dev_[index(device)];
-  const double now = twin_.time_s();
-  if (s.role == drivers::SignalRole::heartbeat) {
-    if (v != d.heartbeat) d.heartbeat_change_s = now;
-    d.heartbeat = v;
-    return {};
-  }
-  if (s.role == drivers::SignalRole::window_length) {
-    if (!(v > 0)) return make_error_code(errc::invalid_argument);
-    d.window_length_ms = v;
-    return {};
-  }
-  if (s.role == drivers::SignalRole::window_start) return v != 0 ? start_window(device) : std::error_code{};
-
-  auto& synrm = twin_.synrm_drive();
-  auto& load = twin_.load_drive();
-  switch (device) {
-    case DeviceKind::synrm_drive:
-      if (n == "enable") {
-        const auto ec = synrm.enable(v != 0);
-        if (!ec && v != 0) d.heartbeat_change_s = now;  // the watchdog counts from the enable
-        return ec;
-      }
-      if (n == "fault_reset") return reset_requested(d, v) ? synrm.reset_fault() : std::error_code{};
-      if (n == "speed_setpoint_rpm") {
-        const auto ec = synrm.set_speed_rpm(v);
-        if (!ec) speed_set_rpm_ = v;
-        return ec;
-      }
-      if (n == "angle_setpoint_deg") {
-        const auto ec = synrm.set_angle_deg(v);
-        if (!ec) angle_set_deg_ = v;
-        return ec;
-      }
-      if (n == "pwm_scheme") return synrm.set_pwm(static_cast<drivers::Pwm>(static_cast<int>(v)));
-      if (n == "estimator") {
-        const auto e = static_cast<drivers::Estimator>(static_cast<int>(v));
-        const auto ec = synrm.set_estimator(e);
-        if (!ec) estimator_ = e;
-        return ec;
-      }
-      break;
-    case DeviceKind::load_drive:
-      if (n == "enable") {
-        const auto ec = load.enable(v != 0);
-        if (!ec && v != 0) d.heartbeat_change_s = now;
-        return ec;
-      }
-      if (n == "fault_reset") return reset_requested(d, v) ? load.reset_fault() : std::error_code{};
-      if (n == "torque_setpoint_Nm") {
-        const auto ec = load.set_torque_Nm(v);
-        if (!ec) torque_set_Nm_ = v;
-        return ec;
-      }
-      break;
-    case DeviceKind::vfc_meter:
-      if (n == "f0_Hz") {
-        f0_Hz_ = v;
-        return {};
-      }
-      if (n == "kf_Hz_per_A") {
-        if (v == 0) return make_error_code(errc::invalid_argument);
-        kf_Hz_per_A_ = v;
-        return {};
-      }
-      break;
-  }
-  return make_error_code(errc::not_supported);
+  const Control* c = find_control(device, s.name);
+  return c && c->write ? c->write(*this, device, v) : make_error_code(errc::not_supported);
 }
 
 void TwinSignals::check_watchdogs() {

@@ -1,16 +1,20 @@
 // The firmware side of the twin's register map: what each signal of the default profiles means
-// on the twin's drives and meter, plus what a drive does around its registers: the watchdog the
-// profile names (counter: the heartbeat must change within timeout_ms while a drive is enabled;
-// any_write: some write must arrive within it; else both drives stop in order and latch fault 6;
-// none: no timer), the fault reset (on the level, or with a pulse-reset profile only on a rising
-// edge, as a drive that wants a pulse does), and the measurement windows with their status
-// and sequence numbers. The three devices share one trigger, as on the thesis bench: the first
-// window start opens the twin's window on all of them, a start on another device while it is
-// open joins it (same length), and each participant's results are published when it closes.
+// on the twin's drives and meter (the structs' signals through drivers/device_signals.hpp, the
+// control and status signals through a table of their own), plus what a drive does around its
+// registers: the watchdog the profile names (counter: the heartbeat must change within
+// timeout_ms while a drive is enabled; any_write: some write must arrive within it; else both
+// drives stop in order and latch fault 6; none: no timer), the fault reset (on the level, or
+// with a pulse-reset profile only on a rising edge, as a drive that wants a pulse does), and the
+// measurement windows with their status and sequence numbers. The three devices share one
+// trigger, as on the thesis bench: the first window start opens the twin's window on all of
+// them, a start on another device while it is open joins it (same length), and each
+// participant's results are published when it closes.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include "drivers/devices.hpp"
@@ -24,6 +28,8 @@ namespace synbench::emulator {
 class TwinSignals final : public SignalProvider {
  public:
   // The profiles give the heartbeat timeouts; their signals are served by RegisterServer.
+  // std::invalid_argument naming the device and the signal when a profile maps a signal the
+  // twin has no value for: a register that would read 0 whatever the plant does.
   TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& profiles);
 
   double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) override;
@@ -49,7 +55,27 @@ class TwinSignals final : public SignalProvider {
       if (d.timeout_s > 0) d.timeout_s = timeout_s;
   }
 
+  // The structs the registers show: the firmware's telemetry and each device's last window.
+  struct Served {
+    drivers::SynrmTelemetry synrm;
+    drivers::SynrmWindow synrm_window;
+    drivers::LoadTelemetry load;
+    drivers::LoadWindow load_window;
+    drivers::MeterReading meter_window;
+  };
+  // Test hook: the registers show `fixed` instead (a round trip with chosen values); nullopt
+  // goes back to the firmware's.
+  void serve_fixed(std::optional<Served> fixed) { fixed_ = std::move(fixed); }
+
  private:
+  struct Control;
+  // The control or status signal of `device` that is no struct's member, or null.
+  static const Control* find_control(drivers::DeviceKind device, std::string_view signal);
+  // The engineering value of a signal, empty when the twin has none.
+  std::optional<double> value(drivers::DeviceKind device, const drivers::ProfileSignal& s) const;
+  drivers::SynrmTelemetry synrm_telemetry() const;
+  drivers::LoadTelemetry load_telemetry() const;
+
   struct Device {
     double heartbeat = 0;
     double heartbeat_change_s = 0;
@@ -70,9 +96,6 @@ class TwinSignals final : public SignalProvider {
   void check_watchdogs();
   void close_window();
   std::error_code start_window(drivers::DeviceKind k);
-  double synrm_value(const std::string& name) const;
-  double load_value(const std::string& name) const;
-  double meter_value(const std::string& name) const;
 
   Twin& twin_;
   std::array<Device, 3> dev_;
@@ -83,10 +106,9 @@ class TwinSignals final : public SignalProvider {
   double speed_set_rpm_ = 0, angle_set_deg_ = 0, torque_set_Nm_ = 0;
   drivers::Estimator estimator_ = drivers::Estimator::encoder;
   double f0_Hz_, kf_Hz_per_A_;  // the meter's calibration, used to turn counts into currents
-  // Results of each device's last window.
-  drivers::SynrmWindow synrm_window_;
-  drivers::LoadWindow load_window_;
-  drivers::MeterReading meter_window_;
+  // Results of each device's last window (telemetry is the firmware's own).
+  Served windows_;
+  std::optional<Served> fixed_;
   TwinInstruments instruments_;
 };
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
 #include <sstream>
 #include <thread>
@@ -282,7 +283,16 @@ int emulate_command(const std::vector<std::string>& argv) {
     for (const auto& e : notes.errors) std::cerr << "synbench emulate: " << profiles_option << ": " << e << "\n";
     return 2;
   }
-  emulator::TwinService service(config, std::move(profiles));
+  // A profile that maps a signal the twin has no value for is refused, naming the device and
+  // the signal, rather than served as a register stuck at 0.
+  std::unique_ptr<emulator::TwinService> twin;
+  try {
+    twin = std::make_unique<emulator::TwinService>(config, std::move(profiles));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "synbench emulate: " << profiles_option << ": " << e.what() << "\n";
+    return 2;
+  }
+  emulator::TwinService& service = *twin;
   for (const auto& [unit, signal] : stuck) {
     const auto ec = service.locked([&](auto&, auto&, emulator::RegisterServer& server) {
       return server.stick(static_cast<std::uint8_t>(unit), signal);
