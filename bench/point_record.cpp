@@ -1,6 +1,7 @@
-// JSON and text forms of a point record.
+// JSON and text forms of a point record: loops over its member table.
 #include "bench/point_record.hpp"
 
+#include "bench/point_record_fields.hpp"
 #include "drivers/json.hpp"
 
 #include <cstdio>
@@ -9,66 +10,34 @@
 namespace synbench::bench {
 namespace {
 
-synbench::Json opt(const std::optional<double>& v) {
-  return v ? synbench::Json(*v) : synbench::Json(nullptr);
+template <class T>
+synbench::Json value_json(const T& v);
+template <class T>
+synbench::Json value_json(const std::optional<T>& v);
+
+template <class S>
+synbench::Json object_json(const S& s) {
+  synbench::Json j = synbench::Json::object();
+  for_each_field(FieldTable<S>::fields, [&](const auto& f) { j[f.name] = value_json(s.*f.member); });
+  return j;
+}
+
+template <class T>
+synbench::Json value_json(const T& v) {
+  if constexpr (TextField<T>) return std::string(field_text(v));
+  else if constexpr (HasFieldTable<T>) return object_json(v);
+  else return synbench::Json(v);
+}
+
+template <class T>
+synbench::Json value_json(const std::optional<T>& v) {
+  return v ? value_json(*v) : synbench::Json(nullptr);
 }
 
 }  // namespace
 
-synbench::Json to_json(const PointRecord& r) {
-  synbench::Json j = synbench::Json::object();
-  j["speed_rpm"] = r.speed_rpm;
-  j["load_Nm"] = r.load_Nm;
-  j["angle_deg"] = r.angle_deg;
-  j["estimator"] = std::string(drivers::name(r.estimator));
-  j["pwm"] = std::string(drivers::name(r.pwm));
-  j["speed_meas_rpm"] = r.speed_meas_rpm;
-  j["im_A"] = r.im_A;
-  j["id_A"] = r.id_A;
-  j["iq_A"] = r.iq_A;
-  j["ud_V"] = r.ud_V;
-  j["uq_V"] = r.uq_V;
-  j["udc_V"] = r.udc_V;
-  j["idcm_A"] = r.idcm_A;
-  j["idcg_A"] = r.idcg_A;
-  j["pdcm_W"] = r.pdcm_W;
-  j["pdcg_W"] = r.pdcg_W;
-  j["pm_W"] = r.pm_W;
-  j["efficiency"] = r.efficiency;
-  j["pos_err_min_deg"] = opt(r.pos_err_min_deg);
-  j["pos_err_mean_deg"] = opt(r.pos_err_mean_deg);
-  j["pos_err_max_deg"] = opt(r.pos_err_max_deg);
-  j["speed_err_rpm"] = opt(r.speed_err_rpm);
-  j["ld_est_H"] = opt(r.ld_est_H);
-  j["lq_est_H"] = opt(r.lq_est_H);
-  j["rs_est_ohm"] = opt(r.rs_est_ohm);
-  j["ld_err_pct"] = opt(r.ld_err_pct);
-  j["lq_err_pct"] = opt(r.lq_err_pct);
-  j["rs_err_pct"] = opt(r.rs_err_pct);
-  j["temp_C"] = opt(r.temp_C);
-  j["window_s"] = r.window_s;
-  j["samples"] = r.samples;
-  j["settle_s"] = r.settle_s;
-  j["voltage_limited"] = r.voltage_limited;
-  j["unstable"] = r.unstable;
-  j["fault"] = r.fault ? synbench::Json(*r.fault) : synbench::Json(nullptr);
-  j["below_min_speed"] = r.below_min_speed;
-  j["fallback_fraction"] = r.fallback_fraction;
-  j["lock_lost"] = r.lock_lost;
-  j["window_source"] = drivers::keeper_name(r.window_source);
-  j["fault_code_raw"] = r.fault_code_raw ? synbench::Json(*r.fault_code_raw) : synbench::Json(nullptr);
-  j["angle_meas_deg"] = opt(r.angle_meas_deg);
-  j["angle_off"] = r.angle_off;
-  if (r.truth) {
-    const auto& t = *r.truth;
-    j["truth"] = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W}, {"pfe_W", t.pfe_W},
-                  {"pmech_W", t.pmech_W}, {"pinvm_W", t.pinvm_W}, {"pm_W", t.pm_W},
-                  {"temp_C", t.temp_C}};
-  } else {
-    j["truth"] = nullptr;
-  }
-  return j;
-}
+synbench::Json to_json(const PointRecord& r) { return object_json(r); }
+synbench::Json to_json(const drivers::TruthWindow& t) { return object_json(t); }
 
 std::string to_text(const PointRecord& r) {
   std::ostringstream s;

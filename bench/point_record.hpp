@@ -1,5 +1,6 @@
 // One measured operating point, with the field names of experiment.md Sec. 2.5: the one schema
-// used by the JSON output, the database, CSV export and the REST API.
+// used by the JSON output, the database, CSV export and the REST API. A member added here goes
+// into its table too (bench/point_record_fields.hpp; a static_assert there insists).
 #pragma once
 
 #include "drivers/json_fwd.hpp"
@@ -53,7 +54,10 @@ struct PointRecord {
   std::optional<drivers::TruthWindow> truth;
 };
 
+// An object with the table's fields in its order (bench/point_record_fields.hpp): numbers, enums
+// by name, null for an empty optional, truth as an object of its own table.
 synbench::Json to_json(const PointRecord& r);
+synbench::Json to_json(const drivers::TruthWindow& t);
 // The same record for people: one "name  value" line per field.
 std::string to_text(const PointRecord& r);
 

@@ -1,10 +1,13 @@
-// CSV and JSON export of stored points. Both walk bench::to_json's output, so a field added to the
-// record appears here without a change.
+// CSV and JSON export of stored points. CSV walks the record's member table, JSON bench::to_json
+// (itself the table), so a field added to the record appears here without a change.
 #include "db/export.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <string_view>
+#include <type_traits>
+
+#include "bench/point_record_fields.hpp"
 
 namespace synbench::db {
 namespace {
@@ -33,37 +36,54 @@ void append_text(std::string& out, std::string_view s) {
   out += '"';
 }
 
-void append_value(std::string& out, const synbench::Json& v) {
-  if (v.is_null()) return;
-  if (v.is_number_float()) append_number(out, v.get<double>());
-  else if (v.is_number_unsigned()) out += std::to_string(v.get<std::uint64_t>());
-  else if (v.is_number_integer()) out += std::to_string(v.get<std::int64_t>());
-  else if (v.is_boolean()) out += v.get<bool>() ? "true" : "false";
-  else if (v.is_string()) append_text(out, v.get_ref<const std::string&>());
-  else append_text(out, v.dump());  // nothing in the record today; kept readable if it comes
+using bench::HasFieldTable;
+
+// One CSV cell per field, a field with a table of its own (truth) as one per field of that table.
+template <class T>
+constexpr std::size_t cell_count() {
+  if constexpr (HasFieldTable<T>) return std::tuple_size_v<std::remove_cvref_t<decltype(bench::FieldTable<T>::fields)>>;
+  else return 1;
 }
 
-// The truth object's keys, from the record's own JSON form.
-synbench::Json truth_template() {
-  bench::PointRecord r;
-  r.truth = drivers::TruthWindow{};
-  return bench::to_json(r)["truth"];
+template <class S>
+void append_header(std::vector<std::string>& cols, const std::string& prefix) {
+  bench::for_each_field(bench::FieldTable<S>::fields, [&](const auto& f) {
+    using T = bench::held_t<typename std::decay_t<decltype(f)>::value_type>;
+    if constexpr (HasFieldTable<T>) append_header<T>(cols, prefix + std::string(f.name) + "_");
+    else cols.push_back(prefix + std::string(f.name));
+  });
+}
+
+template <class T>
+void append_cells(std::string& out, const std::optional<T>& v);
+
+// Appends ",cell" for each of the value's cells.
+template <class T>
+void append_cells(std::string& out, const T& v) {
+  if constexpr (HasFieldTable<T>) {
+    bench::for_each_field(bench::FieldTable<T>::fields, [&](const auto& f) { append_cells(out, v.*f.member); });
+  } else {
+    out += ',';
+    if constexpr (std::is_same_v<T, double>) append_number(out, v);
+    else if constexpr (std::is_same_v<T, bool>) out += v ? "true" : "false";
+    else if constexpr (std::is_integral_v<T>) out += std::to_string(v);
+    else if constexpr (bench::TextField<T>) append_text(out, bench::field_text(v));
+    else append_text(out, v);
+  }
+}
+
+// An empty optional leaves its cells empty, so every line has the header's width.
+template <class T>
+void append_cells(std::string& out, const std::optional<T>& v) {
+  if (v) append_cells(out, *v);
+  else out.append(cell_count<T>(), ',');
 }
 
 }  // namespace
 
 std::vector<std::string> csv_columns() {
   std::vector<std::string> cols{"point_index"};
-  bench::PointRecord r;
-  r.truth = drivers::TruthWindow{};
-  const auto j = bench::to_json(r);  // named: items() only refers to it
-  for (const auto& [key, value] : j.items()) {
-    if (key != "truth") {
-      cols.push_back(key);
-      continue;
-    }
-    for (const auto& [tkey, tvalue] : value.items()) cols.push_back("truth_" + tkey);
-  }
+  append_header<bench::PointRecord>(cols, "");
   return cols;
 }
 
@@ -75,22 +95,9 @@ std::string points_to_csv(std::span<const PointRow> rows) {
     out += cols[i];
   }
   out += '\n';
-  const auto truth_keys = truth_template();
   for (const auto& row : rows) {
     out += std::to_string(row.index);
-    const auto j = bench::to_json(row.record);
-    for (const auto& [key, value] : j.items()) {
-      if (key != "truth") {
-        out += ',';
-        append_value(out, value);
-        continue;
-      }
-      // A null truth still takes its columns, empty, so every line has the header's width.
-      for (const auto& [tkey, tvalue] : truth_keys.items()) {
-        out += ',';
-        if (value.is_object()) append_value(out, value.at(tkey));
-      }
-    }
+    append_cells(out, row.record);
     out += '\n';
   }
   return out;

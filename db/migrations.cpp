@@ -12,7 +12,7 @@ namespace {
 
 // Version 1: sweeps, points, events. STRICT tables, so a value of the wrong type is refused.
 // Point columns carry experiment.md Sec. 2.5's names in the record's order (tests/db checks them
-// against bench::to_json). The record's numbers are declared ANY with a typeof CHECK instead of
+// against the record's member table, bench/point_record_fields.hpp). The record's numbers are declared ANY with a typeof CHECK instead of
 // REAL because REAL affinity stores integral values as integers and so turns -0.0 into 0.0; ANY
 // keeps the exact double. They are nullable: optional fields are NULL when absent, and a NULL in a
 // required field is a NaN (SQLite cannot store NaN). Estimator and PWM names are not CHECKed, so

@@ -2,9 +2,7 @@
 #include "db/store.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <ctime>
-#include <limits>
 #include <stdexcept>
 
 #include "db/file_watch.hpp"
@@ -51,26 +49,22 @@ bool finished(SweepState s) {
   return s == SweepState::completed || s == SweepState::aborted || s == SweepState::faulted;
 }
 
-// The record's columns as SQL lists, generated from the one column table.
+// The record's columns as an SQL list, from the record's member table (truth among them).
 std::string record_column_list() {
   std::string s;
-  for (const auto& c : detail::kRecordColumns) {
-    s += c.name;
-    s += ", ";
-  }
+  for (const auto& c : detail::record_columns()) s += (s.empty() ? "" : ", ") + c;
   return s;
 }
 
 std::string insert_point_sql() {
-  std::string sql = "INSERT INTO points (sweep_id, point_index, " + record_column_list() +
-                    "truth_json, measured_at) VALUES (?, ?";
-  for (std::size_t i = 0; i < detail::kRecordColumns.size() + 2; ++i) sql += ", ?";
+  std::string sql =
+      "INSERT INTO points (sweep_id, point_index, " + record_column_list() + ", measured_at) VALUES (?, ?";
+  for (int i = 0; i < detail::kRecordColumnCount + 1; ++i) sql += ", ?";
   return sql + ")";
 }
 
 std::string select_points_sql() {
-  return "SELECT point_index, " + record_column_list() +
-         "truth_json FROM points WHERE sweep_id = ? ORDER BY point_index";
+  return "SELECT point_index, " + record_column_list() + " FROM points WHERE sweep_id = ? ORDER BY point_index";
 }
 
 constexpr std::string_view kSweepColumns =
@@ -78,127 +72,6 @@ constexpr std::string_view kSweepColumns =
     "s.software_version, s.profiles_json, s.bench_config_json, s.calibration_json, "
     "s.total_points, s.last_error, (SELECT count(*) FROM points p WHERE p.sweep_id = s.id) "
     "FROM sweeps s";
-
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
-
-void bind_record(Statement& st, int first, const bench::PointRecord& r) {
-  int i = first;
-  for (const auto& c : detail::kRecordColumns) {
-    std::visit(Overloaded{
-                   [&](double bench::PointRecord::*m) {
-                     // NaN has no SQLite form; NULL in a required column means NaN.
-                     if (std::isnan(r.*m)) st.bind_null(i); else st.bind(i, r.*m);
-                   },
-                   [&](std::optional<double> bench::PointRecord::*m) {
-                     if (!(r.*m) || std::isnan(*(r.*m))) st.bind_null(i); else st.bind(i, *(r.*m));
-                   },
-                   [&](drivers::Estimator bench::PointRecord::*m) { st.bind(i, drivers::name(r.*m)); },
-                   [&](drivers::Pwm bench::PointRecord::*m) { st.bind(i, drivers::name(r.*m)); },
-                   [&](std::uint32_t bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m}); },
-                   [&](bool bench::PointRecord::*m) { st.bind(i, std::int64_t{r.*m ? 1 : 0}); },
-                   [&](std::optional<std::string> bench::PointRecord::*m) { st.bind(i, r.*m); },
-                   [&](drivers::WindowKeeper bench::PointRecord::*m) {
-                     st.bind(i, std::string_view(drivers::keeper_name(r.*m)));
-                   },
-                   [&](std::optional<std::int64_t> bench::PointRecord::*m) { st.bind(i, r.*m); },
-               },
-               c.member);
-    ++i;
-  }
-}
-
-Status read_record(const Statement& st, int first, bench::PointRecord& r) {
-  int i = first;
-  for (const auto& c : detail::kRecordColumns) {
-    Status s = std::visit(
-        Overloaded{
-            [&](double bench::PointRecord::*m) -> Status {
-              r.*m = st.is_null(i) ? std::numeric_limits<double>::quiet_NaN() : st.real(i);
-              return {};
-            },
-            [&](std::optional<double> bench::PointRecord::*m) -> Status {
-              r.*m = st.is_null(i) ? std::nullopt : std::optional<double>(st.real(i));
-              return {};
-            },
-            [&](drivers::Estimator bench::PointRecord::*m) -> Status {
-              const auto v = drivers::parse_estimator(st.text(i));
-              if (!v) return make_error(errc::bad_record, "unknown estimator \"" + st.text(i) + "\"");
-              r.*m = *v;
-              return {};
-            },
-            [&](drivers::Pwm bench::PointRecord::*m) -> Status {
-              const auto v = drivers::parse_pwm(st.text(i));
-              if (!v) return make_error(errc::bad_record, "unknown pwm \"" + st.text(i) + "\"");
-              r.*m = *v;
-              return {};
-            },
-            [&](std::uint32_t bench::PointRecord::*m) -> Status {
-              const auto v = st.integer(i);
-              if (v < 0 || v > std::numeric_limits<std::uint32_t>::max())
-                return make_error(errc::bad_record, std::string(c.name) + " out of range");
-              r.*m = static_cast<std::uint32_t>(v);
-              return {};
-            },
-            [&](bool bench::PointRecord::*m) -> Status {
-              r.*m = st.integer(i) != 0;
-              return {};
-            },
-            [&](std::optional<std::string> bench::PointRecord::*m) -> Status {
-              r.*m = st.opt_text(i);
-              return {};
-            },
-            [&](drivers::WindowKeeper bench::PointRecord::*m) -> Status {
-              const std::string v = st.text(i);
-              if (v != "device" && v != "host")
-                return make_error(errc::bad_record, "unknown window_source \"" + v + "\"");
-              r.*m = v == "host" ? drivers::WindowKeeper::host : drivers::WindowKeeper::device;
-              return {};
-            },
-            [&](std::optional<std::int64_t> bench::PointRecord::*m) -> Status {
-              r.*m = st.is_null(i) ? std::nullopt : std::optional<std::int64_t>(st.integer(i));
-              return {};
-            },
-        },
-        c.member);
-    if (!s) return s;
-    ++i;
-  }
-  return {};
-}
-
-std::string truth_text(const drivers::TruthWindow& t) {
-  // The same object as the record's JSON "truth"; nlohmann writes doubles in their shortest
-  // round-trip form, so the values come back bit for bit.
-  const synbench::Json j = {{"pin_W", t.pin_W},     {"pcu_W", t.pcu_W},     {"pfe_W", t.pfe_W},
-                                    {"pmech_W", t.pmech_W}, {"pinvm_W", t.pinvm_W}, {"pm_W", t.pm_W},
-                                    {"temp_C", t.temp_C}};
-  return j.dump();
-}
-
-Result<drivers::TruthWindow> parse_truth(const std::string& text) {
-  const auto j = synbench::Json::parse(text, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return make_error(errc::bad_record, "truth_json is not a JSON object");
-  drivers::TruthWindow t;
-  const std::pair<const char*, double drivers::TruthWindow::*> fields[] = {
-      {"pin_W", &drivers::TruthWindow::pin_W},     {"pcu_W", &drivers::TruthWindow::pcu_W},
-      {"pfe_W", &drivers::TruthWindow::pfe_W},     {"pmech_W", &drivers::TruthWindow::pmech_W},
-      {"pinvm_W", &drivers::TruthWindow::pinvm_W}, {"pm_W", &drivers::TruthWindow::pm_W},
-      {"temp_C", &drivers::TruthWindow::temp_C}};
-  for (const auto& [key, member] : fields) {
-    const auto it = j.find(key);
-    if (it == j.end()) return make_error(errc::bad_record, std::string("truth_json has no ") + key);
-    // JSON has no NaN or infinity; nlohmann writes them as null, which comes back as NaN.
-    if (it->is_null()) t.*member = std::numeric_limits<double>::quiet_NaN();
-    else if (it->is_number()) t.*member = it->get<double>();
-    else return make_error(errc::bad_record, std::string("truth_json.") + key + " is not a number");
-  }
-  return t;
-}
 
 }  // namespace
 
@@ -632,10 +505,8 @@ Status Store::insert_point(std::int64_t sweep_id, std::int64_t point_index, cons
     Statement::Use use(st);
     st.bind(1, sweep_id);
     st.bind(2, point_index);
-    bind_record(st, 3, record);
-    const int base = 3 + static_cast<int>(detail::kRecordColumns.size());
-    st.bind(base, record.truth ? std::optional<std::string>(truth_text(*record.truth)) : std::nullopt);
-    st.bind(base + 1, now_utc());
+    detail::bind_record(st, 3, record);
+    st.bind(3 + detail::kRecordColumnCount, now_utc());
     const int rc = st.step();
     // The transaction rolls back on the way out; the stored point is untouched.
     if (rc == SQLITE_CONSTRAINT_UNIQUE || rc == SQLITE_CONSTRAINT_PRIMARYKEY)
@@ -655,7 +526,6 @@ Result<std::vector<PointRow>> Store::points(std::int64_t sweep_id) {
   Statement::Use use(st);
   st.bind(1, sweep_id);
   std::vector<PointRow> out;
-  const int truth_col = 1 + static_cast<int>(detail::kRecordColumns.size());
   for (;;) {
     const int rc = st.step();
     if (rc == SQLITE_DONE) return out;
@@ -663,12 +533,8 @@ Result<std::vector<PointRow>> Store::points(std::int64_t sweep_id) {
     PointRow row;
     row.index = st.integer(0);
     const auto where = [&] { return "point " + std::to_string(row.index) + " of sweep " + std::to_string(sweep_id); };
-    if (auto s = read_record(st, 1, row.record); !s) return make_error(errc::bad_record, where() + ": " + s.error().message);
-    if (!st.is_null(truth_col)) {
-      auto t = parse_truth(st.text(truth_col));
-      if (!t) return make_error(errc::bad_record, where() + ": " + t.error().message);
-      row.record.truth = *t;
-    }
+    if (auto s = detail::read_record(st, 1, row.record); !s)
+      return make_error(errc::bad_record, where() + ": " + s.error().message);
     out.push_back(std::move(row));
   }
 }

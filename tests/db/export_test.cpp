@@ -59,6 +59,21 @@ TEST(CsvExport, HeaderIsTheRecordFieldsThenTruthColumns) {
   EXPECT_EQ(points_to_csv({}), expected);
 }
 
+TEST(CsvExport, HeaderIsToJsonsKeysWithTruthFlattened) {
+  // The CSV walks the member table, bench::to_json its own loop: the two must name the same fields.
+  bench::PointRecord r;
+  r.truth = drivers::TruthWindow{};
+  std::vector<std::string> expected{"point_index"};
+  const auto j = bench::to_json(r);
+  for (const auto& [key, value] : j.items()) {
+    if (!value.is_object()) expected.push_back(key);
+    else
+      for (const auto& [tkey, tvalue] : value.items()) expected.push_back(key + "_" + tkey);
+  }
+  EXPECT_EQ(csv_columns(), expected);
+  EXPECT_EQ(csv_columns().size(), 50u) << "docs/database.md gives the count";
+}
+
 TEST(CsvExport, EveryValueReadsBackExactly) {
   const auto rows = sample_rows(30);
   const auto table = parse_csv(points_to_csv(rows));
@@ -94,6 +109,9 @@ TEST(CsvExport, EveryValueReadsBackExactly) {
       }
     }
     EXPECT_EQ(line[col("estimator")], std::string(drivers::name(r.estimator)));
+    EXPECT_EQ(line[col("window_source")], drivers::keeper_name(r.window_source));
+    EXPECT_EQ(line[col("fault_code_raw")], r.fault_code_raw ? std::to_string(*r.fault_code_raw) : "");
+    EXPECT_EQ(line[col("angle_off")], r.angle_off ? "true" : "false");
     EXPECT_EQ(line[col("samples")], std::to_string(r.samples));
     EXPECT_EQ(line[col("voltage_limited")], r.voltage_limited ? "true" : "false");
     EXPECT_EQ(line[col("fault")], r.fault.value_or(""));

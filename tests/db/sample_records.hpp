@@ -63,6 +63,7 @@ inline bench::PointRecord sample_record(std::int64_t i) {
   r.below_min_speed = i % 5 == 2;
   r.fallback_fraction = r.below_min_speed ? 1.0 - 1.0 / (3.0 + x) : 0.0;
   r.lock_lost = i % 7 == 4;
+  r.window_source = i % 9 == 7 ? drivers::WindowKeeper::host : drivers::WindowKeeper::device;
   if (i % 5 == 3) r.fault = i % 10 == 3 ? "overcurrent" : "link_loss, \"quoted\"";  // CSV quoting
   if (i % 10 == 9) {
     r.fault = "unknown";  // a device code without a label, kept as the device sent it

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <regex>
+#include <set>
+
+#include "bench/point_record_fields.hpp"
 
 #include "tests/db/sample_records.hpp"
 
@@ -177,6 +180,56 @@ TEST_F(StoreTest, EveryFieldRoundTripsExactly) {
   EXPECT_EQ((*rows)[19].record.fault_code_raw, 0x2310 + 19);
   EXPECT_EQ((*rows)[9].record.fault_code_raw, 4'294'967'295);
   EXPECT_FALSE((*rows)[13].record.fault_code_raw);
+}
+
+TEST_F(StoreTest, TheSamplesSetEveryField) {
+  // The round trip above proves a field only if some sample gives it a value of its own: a field
+  // added to the record and not to sample_record() fails here.
+  const auto defaults = bench::to_json(bench::PointRecord{});
+  auto with_truth = bench::PointRecord{};
+  with_truth.truth = drivers::TruthWindow{};
+  const auto default_truth = bench::to_json(with_truth)["truth"];
+  std::set<std::string> set;
+  for (std::int64_t i = 0; i < 60; ++i) {
+    const auto j = bench::to_json(sample_record(i));
+    for (const auto& [key, value] : j.items())
+      if (value.dump() != defaults[key].dump()) set.insert(key);
+    if (j["truth"].is_object())
+      for (const auto& [key, value] : j["truth"].items())
+        if (value.dump() != default_truth[key].dump()) set.insert("truth." + key);
+  }
+  bench::for_each_field(bench::kPointRecordFields, [&](const auto& f) { EXPECT_TRUE(set.contains(std::string(f.name))) << f.name; });
+  bench::for_each_field(bench::kTruthFields, [&](const auto& f) { EXPECT_TRUE(set.contains("truth." + std::string(f.name))) << f.name; });
+}
+
+TEST_F(StoreTest, AValueTheRecordCannotHoldIsABadRecordNamingItsColumn) {
+  // Another connection writes what the store never would; points() names the point and column.
+  const auto read_after = [&](const std::string& set) -> std::string {
+    const auto id = make_sweep(1);
+    EXPECT_TRUE(store_->insert_point(id, 0, sample_record(1)));  // one with truth
+    sqlite3* raw = nullptr;
+    EXPECT_EQ(sqlite3_open((dir_ / "store.db").c_str(), &raw), SQLITE_OK);
+    const std::string sql = "UPDATE points SET " + set + " WHERE sweep_id = " + std::to_string(id);
+    EXPECT_EQ(sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(raw);
+    sqlite3_close(raw);
+    const auto rows = store_->points(id);
+    if (rows) return "read: " + exact_text(rows->at(0).record);
+    EXPECT_EQ(rows.code(), errc::bad_record) << set;
+    const std::string prefix = "point 0 of sweep " + std::to_string(id) + ": ";
+    EXPECT_EQ(rows.error().message.rfind(prefix, 0), 0u) << rows.error().message;
+    return rows.error().message.substr(prefix.size());
+  };
+  EXPECT_EQ(read_after("estimator = 'warp'"), "unknown estimator \"warp\"");
+  EXPECT_EQ(read_after("pwm = ''"), "unknown pwm \"\"");
+  EXPECT_EQ(read_after("samples = 4294967296"), "samples out of range");
+  EXPECT_EQ(read_after("truth_json = '[1]'"), "truth_json is not a JSON object");
+  EXPECT_EQ(read_after("truth_json = 'not json'"), "truth_json is not a JSON object");
+  EXPECT_EQ(read_after("truth_json = json_remove(truth_json, '$.pcu_W')"), "truth_json has no pcu_W");
+  EXPECT_EQ(read_after("truth_json = json_set(truth_json, '$.pfe_W', 'x')"), "truth_json.pfe_W is not a number");
+  // A null in the truth object is JSON's NaN.
+  auto nan_truth = sample_record(1);
+  nan_truth.truth->pm_W = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(read_after("truth_json = json_set(truth_json, '$.pm_W', json('null'))"), "read: " + exact_text(nan_truth));
 }
 
 TEST_F(StoreTest, NanInARequiredFieldComesBackAsNan) {
