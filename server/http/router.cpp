@@ -7,9 +7,12 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
+#include "drivers/json_file.hpp"
 #include "drivers/utf8.hpp"
+#include "server/http/json_schema.hpp"
 #include "server/http/url_text.hpp"
 
 namespace synbench::http {
@@ -107,7 +110,15 @@ bool match_pattern(std::string_view pattern, std::string_view path, std::map<std
   return true;
 }
 
-void Router::add(Route route) { routes_.push_back(std::move(route)); }
+void Router::add(Route route) {
+  for (const auto* schema : {&route.request_schema, &route.response_schema}) {
+    if (!*schema) continue;
+    if (const auto problems = check_schema(**schema); !problems.empty())
+      throw std::invalid_argument(route.method + " " + route.pattern + ": the " +
+                                  (schema == &route.request_schema ? "request" : "response") + " schema: " + to_string(problems));
+  }
+  routes_.push_back(std::move(route));
+}
 
 std::optional<Identity> Router::identify(std::string_view authorization) const {
   const std::size_t sp = authorization.find(' ');
@@ -137,6 +148,21 @@ std::optional<Response> non_utf8_parameter(const Request& req) {
       return error_response(400, "bad_field", "query: the parameter name '" + drivers::escape_invalid_utf8(name) + "' is not valid UTF-8");
     if (!drivers::is_valid_utf8(value)) return error_response(400, "bad_field", name + ": not valid UTF-8");
   }
+  return std::nullopt;
+}
+
+// The body against the route's schema: parsed into req.json, or the 400 saying why not. The
+// handler then sees only a body the published schema allows.
+std::optional<Response> body_problem(const Route& route, Request& req) {
+  if (req.body.empty()) return error_response(400, "bad_json", "the request needs a JSON body");
+  // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
+  // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
+  // ...", a number out of double's range (1e999) included.
+  drivers::JsonParsed parsed = drivers::parse_json_text(req.body);
+  if (!parsed.ok()) return error_response(400, "bad_json", "the body is " + parsed.error);
+  if (const auto errors = validate(*route.request_schema, parsed.doc); !errors.empty())
+    return error_response(400, route.body_error_code, to_string(errors));
+  req.json = std::move(parsed.doc);
   return std::nullopt;
 }
 
@@ -225,6 +251,8 @@ void Router::route_and_call(const std::string& method, const std::string& target
     req.caller_id = caller->id;
   }
   if (auto bad = non_utf8_parameter(req)) return reply(std::move(*bad));
+  if (route->request_schema)
+    if (auto bad = body_problem(*route, req)) return reply(std::move(*bad));
   if (route->async_handler) return route->async_handler(req, reply);
   reply(route->handler(req));
 }
