@@ -1,6 +1,8 @@
 // The answers' schemas; see response_schemas.hpp.
 #include "server/http/response_schemas.hpp"
 
+#include "drivers/modes.hpp"
+
 namespace synbench::http {
 
 synbench::Json closed_object(synbench::Json properties, bool nullable, std::initializer_list<const char*> optional) {
@@ -129,6 +131,37 @@ synbench::Json analysis_schema() {
           {"required", synbench::Json::array({"schema"})},
           {"properties", {{"schema", {{"type", "string"}, {"enum", synbench::Json::array({"synbench.analysis/1"})}}}}},
           {"description", "docs/analysis.md"}};
+}
+
+synbench::Json estimate_schema(bool with_plan) {
+  synbench::Json p = {{"points", kInt},        {"upper_bound", kBool},          {"groups", kInt},
+                      {"speed_changes", kInt}, {"load_changes", kInt},          {"configuration_changes", kInt},
+                      {"bench_time_s", kNum}};
+  if (with_plan) {
+    p["duration_s"] = kNum;
+    p["plan"] = {{"type", "object"}, {"description", "the canonical plan (docs/sweep-plan.md)"}};
+  }
+  return closed_object(std::move(p));
+}
+
+synbench::Json presets_schema() {
+  return {{"type", "array"},
+          {"items", closed_object({{"name", kStr},
+                                   {"description", kStr},
+                                   {"plan", {{"type", "object"}}},
+                                   {"estimate", estimate_schema(false)}})}};
+}
+
+synbench::Json estimators_schema() {
+  return {{"type", "array"},
+          {"items",
+           {{"type", "object"},
+            {"required", synbench::Json::array({"name", "sensorless", "description", "min_speed_rpm"})},
+            {"properties",
+             {{"name", {{"type", "string"}, {"enum", drivers::kEstimatorNames}}},
+              {"sensorless", kBool},
+              {"description", kStr},
+              {"min_speed_rpm", {{"type", "number"}, {"minimum", 0}}}}}}}};
 }
 
 }  // namespace synbench::http

@@ -29,5 +29,10 @@ synbench::Json whoami_schema();        // GET /api/whoami
 synbench::Json sweep_schema(bool with_plan);
 synbench::Json points_schema();        // GET /api/sweeps/{id}/points: point_index and the record (docs/record.md)
 synbench::Json analysis_schema();      // GET /api/sweeps/{id}/analysis: the document's version tag
+// A plan's estimate (bench::to_json(SweepEstimate)); POST /api/sweeps/estimate adds duration_s
+// and the canonical plan.
+synbench::Json estimate_schema(bool with_plan);
+synbench::Json presets_schema();       // GET /api/presets
+synbench::Json estimators_schema();    // GET /api/estimators: each source's own parameters beside the common members
 
 }  // namespace synbench::http

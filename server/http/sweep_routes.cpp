@@ -309,7 +309,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 return r;
               })},
               analysis_schema()));
-  router.add({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
+  router.add(answering({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
               [](const Request&) {
                 synbench::Json out = synbench::Json::array();
                 const auto add = [&out](std::string_view name, const char* description, const bench::SweepPlan& p) {
@@ -324,8 +324,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 add(bench::kIecPreset, "IEC 61800-9-2 drive operating points (speed %, torque %) at 40..76 deg step 2",
                     bench::iec_61800_9_2_plan());
                 return json_response(200, out);
-              }});
-  router.add(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
+              }},
+              presets_schema()));
+  router.add(answering(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
               "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
               worker.offload([](const Request& req) {
                 auto plan = bench::parse_sweep_plan(req.json);
@@ -339,7 +340,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 out["plan"] = bench::to_json(*plan.plan);
                 return json_response(200, out);
               }),
-              plan_schema()}));
+              plan_schema()}),
+                       estimate_schema(true)));
 }
 
 }  // namespace synbench::http

@@ -122,7 +122,7 @@ TEST_F(Api, LiveAnswersConformToThePublishedSchemas) {
         EXPECT_TRUE(errors.empty()) << when << ": " << upper << " " << pattern << ": " << to_string(errors);
         ++checked;
       }
-    EXPECT_EQ(checked, 7u) << when;  // status, health, config, lock x3, whoami
+    EXPECT_EQ(checked, 8u) << when;  // status, health, config, lock x3, whoami, estimators
   };
   check_all("idle");
   ASSERT_EQ(post("/api/bench/estop", "").status, 200);

@@ -113,8 +113,13 @@ TEST_F(SweepRoutes, LiveAnswersConformToThePublishedSchemas) {
     EXPECT_TRUE(errors.empty()) << "GET " << target << ": " << to_string(errors);
     ++checked;
   }
-  // status, health, config, lock, whoami, sweeps, sweep, points, analysis
-  EXPECT_GE(checked, 9u);
+  // status, health, config, lock, whoami, estimators, presets, sweeps, sweep, points, analysis
+  EXPECT_GE(checked, 11u);
+  // The one POST with a published 200 answer.
+  const auto estimate = call("POST", "/api/sweeps/estimate", R"({"preset": "thesis-grid"})", "view");
+  ASSERT_EQ(estimate.status, 200) << estimate.body;
+  const auto& estimate_schema = doc["paths"]["/api/sweeps/estimate"]["post"]["responses"]["200"]["content"]["application/json"]["schema"];
+  EXPECT_EQ(to_string(validate(estimate_schema, synbench::Json::parse(estimate.body))), "");
   const auto points = synbench::Json::parse(call("GET", "/api/sweeps/" + sid + "/points").body);
   EXPECT_EQ(points.size(), 2u);
   // And the schema is not a formality: an answer missing a member fails it.
