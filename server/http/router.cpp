@@ -111,6 +111,8 @@ bool match_pattern(std::string_view pattern, std::string_view path, std::map<std
 }
 
 void Router::add(Route route) {
+  if (route.body_checked_by_handler && !route.async_handler)
+    throw std::invalid_argument(route.method + " " + route.pattern + ": a body checked by the handler needs Worker::offloaded");
   for (const auto* schema : {&route.request_schema, &route.response_schema}) {
     if (!*schema) continue;
     if (const auto problems = check_schema(**schema); !problems.empty())
@@ -151,22 +153,20 @@ std::optional<Response> non_utf8_parameter(const Request& req) {
   return std::nullopt;
 }
 
-// The body against the route's schema: parsed into req.json, or the 400 saying why not. The
-// handler then sees only a body the published schema allows.
-std::optional<Response> body_problem(const Route& route, Request& req) {
+}  // namespace
+
+std::optional<Response> check_body(const synbench::Json& schema, const std::string& error_code, Request& req) {
   if (req.body.empty()) return error_response(400, "bad_json", "the request needs a JSON body");
   // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
   // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
   // ...", a number out of double's range (1e999) included.
   drivers::JsonParsed parsed = drivers::parse_json_text(req.body);
   if (!parsed.ok()) return error_response(400, "bad_json", "the body is " + parsed.error);
-  if (const auto errors = validate(*route.request_schema, parsed.doc); !errors.empty())
-    return error_response(400, route.body_error_code, to_string(errors));
+  if (const auto errors = validate(schema, parsed.doc); !errors.empty())
+    return error_response(400, error_code, to_string(errors));
   req.json = std::move(parsed.doc);
   return std::nullopt;
 }
-
-}  // namespace
 
 void Router::dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
                             std::string body, Reply reply) const {
@@ -251,8 +251,8 @@ void Router::route_and_call(const std::string& method, const std::string& target
     req.caller_id = caller->id;
   }
   if (auto bad = non_utf8_parameter(req)) return reply(std::move(*bad));
-  if (route->request_schema)
-    if (auto bad = body_problem(*route, req)) return reply(std::move(*bad));
+  if (route->request_schema && !route->body_checked_by_handler)
+    if (auto bad = check_body(*route->request_schema, route->body_error_code, req)) return reply(std::move(*bad));
   if (route->async_handler) return route->async_handler(req, reply);
   reply(route->handler(req));
 }

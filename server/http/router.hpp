@@ -74,6 +74,9 @@ struct Route {
   // (json_schema.hpp) before the handler runs, with `body_error_code`.
   std::optional<synbench::Json> request_schema;
   std::string body_error_code = "bad_field";
+  // Set by Worker::offloaded only: the handler runs check_body itself on the worker thread, so
+  // that the io thread never parses a heavy route's (up to 64 KiB) body.
+  bool body_checked_by_handler = false;
   std::optional<synbench::Json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
 };
 
@@ -119,6 +122,11 @@ class Router {
   Authenticator auth_;
   std::vector<Route> routes_;
 };
+
+// `req.body` against a route's request schema: parsed into req.json, or the 400 saying why not
+// (`bad_json` for a missing body or one that is not JSON, else `error_code` listing every
+// problem at its JSON pointer).
+std::optional<Response> check_body(const synbench::Json& schema, const std::string& error_code, Request& req);
 
 // Splits "?a=1&b=x%20y" into decoded pairs; exposed for tests.
 std::map<std::string, std::string> parse_query(std::string_view query);

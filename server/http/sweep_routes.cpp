@@ -326,9 +326,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 return json_response(200, out);
               }},
               presets_schema()));
-  router.add(answering(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
+  router.add(worker.offloaded(answering(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
               "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
-              worker.offload([](const Request& req) {
+              [](const Request& req) {
                 auto plan = bench::parse_sweep_plan(req.json);
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 if (req.caller != Role::operator_ && size_bound(*plan.plan) > kViewerEstimatePoints)
@@ -339,9 +339,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 out["duration_s"] = e.bench_time_s;
                 out["plan"] = bench::to_json(*plan.plan);
                 return json_response(200, out);
-              }),
+              },
               plan_schema()}),
-                       estimate_schema(true)));
+                       estimate_schema(true))));
 }
 
 }  // namespace synbench::http

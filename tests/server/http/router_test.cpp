@@ -165,6 +165,10 @@ TEST(Router, ARouteWhoseSchemaUsesAnUnknownKeywordIsRefused) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("GET /y: the response schema: /format: keyword not implemented"), std::string::npos) << e.what();
   }
+  // Only Worker::offloaded may leave the body check to the handler (it runs it on the worker).
+  Route unchecked{"POST", "/z", Role::anyone, "z", handler, synbench::Json{{"type", "object"}}};
+  unchecked.body_checked_by_handler = true;
+  EXPECT_THROW(r.add(std::move(unchecked)), std::invalid_argument);
   EXPECT_TRUE(r.routes().empty());
 }
 

@@ -68,6 +68,8 @@ std::string error_text(const Response& r) {
   return doc["error"]["code"].get<std::string>() + " " + doc["error"]["message"].get<std::string>();
 }
 
+// The estimate's body is checked on the worker thread (Worker::offloaded), the create's by the
+// router: the same answers either way.
 TEST_F(SweepRoutes, PlanBodiesAreRefusedAtTheirPointer) {
   for (const char* route : {"/api/sweeps", "/api/sweeps/estimate"}) {
     // The published top level, checked by the router: every problem, in the body's order.
