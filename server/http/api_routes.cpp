@@ -3,13 +3,10 @@
 
 #include "server/http/info_routes.hpp"
 
-#include "drivers/json_file.hpp"
-#include "drivers/profile/number_format.hpp"
+#include "server/http/response_schemas.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <memory>
-#include <set>
 #include <sstream>
 
 namespace synbench::http {
@@ -24,34 +21,6 @@ std::map<int, std::uint64_t> HttpMetrics::by_status() const {
   return by_status_;
 }
 
-std::variant<synbench::Json, Response> parse_json_object(const std::string& body) {
-  if (body.empty()) return error_response(400, "bad_json", "the request needs a JSON object body");
-  // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
-  // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
-  // ...", a number out of double's range (1e999) included.
-  drivers::JsonParsed parsed = drivers::parse_json_text(body);
-  if (!parsed.ok()) return error_response(400, "bad_json", "the body is " + parsed.error);
-  if (!parsed.doc.is_object()) return error_response(400, "bad_json", "the body must be a JSON object");
-  return std::move(parsed.doc);
-}
-
-namespace {
-
-
-
-Response bad_field(const std::string& field, const std::string& reason) {
-  return error_response(400, "bad_field", field + ": " + reason);
-}
-
-template <class Names>
-std::string join(const Names& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + std::string(n);
-  return out;
-}
-
-}  // namespace
-
 BenchRuntime::Done answer(Reply reply, int ok_status) {
   // Runs on the bench thread, which has no handler for an exception: guarded makes it a 500.
   return [reply = std::move(reply), ok_status](app::Outcome o) {
@@ -60,17 +29,6 @@ BenchRuntime::Done answer(Reply reply, int ok_status) {
 }
 
 namespace {
-
-// Rejects fields other than `known`, so a typo ("speed") is an error instead of a no-op.
-std::optional<Response> unknown_fields(const synbench::Json& doc, const std::set<std::string>& known) {
-  for (const auto& [k, v] : doc.items())
-    if (!known.count(k)) {
-      std::string list;
-      for (const auto& n : known) list += (list.empty() ? "" : ", ") + n;
-      return bad_field(k, "unknown field (expected: " + list + ")");
-    }
-  return std::nullopt;
-}
 
 synbench::Json number_schema(double min, double max, const std::string& desc) {
   return {{"type", "number"}, {"minimum", min}, {"maximum", max}, {"description", desc}};
@@ -138,61 +96,6 @@ synbench::Json disable_json(const bench::DisableReport& r) {
 // A drive's own code of a fault its profile has no label for (fault "unknown"), else null.
 synbench::Json raw_code(const std::optional<std::int64_t>& code) {
   return code ? synbench::Json(*code) : synbench::Json(nullptr);
-}
-
-synbench::Json object_schema(synbench::Json properties, bool nullable = false) {
-  synbench::Json o = {{"type", "object"}, {"properties", std::move(properties)}};
-  if (nullable) o["nullable"] = true;
-  return o;
-}
-
-// disable_json()'s object for the OpenAPI document: null until a stop's disable was sent.
-synbench::Json disable_schema() {
-  const synbench::Json str = {{"type", "string"}}, boolean = {{"type", "boolean"}};
-  const synbench::Json drive = object_schema(
-      {{"state", {{"type", "string"}, {"enum", {"acknowledged", "repeating", "confirmed"}}}},
-       {"first_acknowledged", boolean},
-       {"attempts", {{"type", "integer"}}},
-       {"error", {{"type", "string"}, {"nullable", true}}},
-       {"confirmed_s", {{"type", "number"}, {"nullable", true}}},
-       {"setpoint_zeroed", boolean}});
-  return object_schema({{"at_s", {{"type", "number"}}}, {"confirmed", boolean}, {"synrm", drive}, {"load", drive}}, true);
-}
-
-// The status object of status_json() for the OpenAPI document (docs/api.md, "Status").
-synbench::Json status_schema() {
-  const synbench::Json num = {{"type", "number"}}, boolean = {{"type", "boolean"}}, str = {{"type", "string"}};
-  const synbench::Json nullable_num = {{"type", "number"}, {"nullable", true}};
-  const synbench::Json code_raw = {{"type", "integer"}, {"nullable", true},
-                                   {"description", "the device's own code of a fault its profile has no label for "
-                                                   "(fault unknown), else null"}};
-  return object_schema(
-      {{"t_s", num},
-       {"enabled", boolean},
-       {"stopping", boolean},
-       {"heartbeats", boolean},
-       {"setpoints", object_schema({{"speed_rpm", num}, {"load_Nm", num}, {"angle_deg", num}})},
-       {"mode", object_schema({{"estimator", str}, {"pwm", str}})},
-       {"synrm", object_schema({{"speed_rpm", num}, {"im_A", num}, {"id_A", num}, {"iq_A", num}, {"ud_V", num},
-                                {"uq_V", num}, {"udc_V", num}, {"pac_W", num}, {"temp_C", nullable_num},
-                                {"voltage_limited", boolean}, {"lock_lost", boolean}, {"pos_err_deg", nullable_num},
-                                {"state", str}, {"fault", str}, {"fault_code_raw", code_raw}},
-                               true)},
-       {"load", object_schema({{"torque_Nm", num}, {"iq_A", num}, {"state", str}, {"fault", str},
-                               {"fault_code_raw", code_raw}},
-                              true)},
-       {"supervisor",
-        object_schema({{"phase", str},
-                       {"tripped", boolean},
-                       {"trip", object_schema({{"fault", str}, {"fault_code_raw", code_raw}, {"detail", str}, {"at_s", num}})},
-                       {"alarm", object_schema({{"detail", str}, {"at_s", num}}, true)},
-                       {"disable", disable_schema()}})},
-       {"loop", object_schema({{"ticks", {{"type", "integer"}}}, {"overruns", {{"type", "integer"}}}})},
-       {"sweep", object_schema({{"id", {{"type", "integer"}}}, {"state", str}, {"done", {{"type", "integer"}}},
-                                {"total", {{"type", "integer"}}}, {"error", str}},
-                               true)},
-       {"events", {{"type", "array"},
-                   {"items", object_schema({{"t_s", num}, {"kind", str}, {"message", str}})}}}});
 }
 
 }  // namespace
@@ -292,12 +195,13 @@ void add_api_routes(Router& router, ApiContext ctx) {
   ControlLock* control = &ctx.control;
 
   add_info_routes(router, *bench, ctx.twin);
-  router.add({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
-              [bench, version](const Request&) {
-                const auto snap = bench->snapshot();
-                const auto& s = snap->status;
-                return json_response(200, {{"status", "ok"}, {"version", version}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
-              }});
+  router.add(answering({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
+                        [bench, version](const Request&) {
+                          const auto snap = bench->snapshot();  // the status lives as long as the snapshot
+                          const auto& s = snap->status;
+                          return json_response(200, {{"status", "ok"}, {"version", version}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
+                        }},
+                       health_schema()));
   router.add({"GET", "/api/openapi.json", Role::anyone, "This API as an OpenAPI 3 document.",
               [self, version](const Request&) { return json_response(200, self->openapi("synbench", version)); }});
   router.add({"GET", "/metrics", Role::anyone, "Prometheus metrics (text format 0.0.4): bench telemetry and HTTP counts.",
@@ -307,31 +211,33 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 r.body = prometheus_text(bench->snapshot()->status, metrics->by_status(), metrics->ws(), metrics->connections());
                 return r;
               }});
-  Route status{"GET", "/api/bench/status", Role::viewer,
-               "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
-               [bench](const Request&) { return status_response(*bench->snapshot()); }};
-  status.response_schema = status_schema();
-  router.add(std::move(status));
-  router.add({"GET", "/api/bench/config", Role::viewer, "Limits the bench's setpoints are validated against.",
-              [max_speed_rpm, max_load_Nm](const Request&) {
-                return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},
-                                           {"load_Nm", {{"min", 0}, {"max", max_load_Nm}}},
-                                           {"angle_deg", {{"min_exclusive", 0}, {"max_exclusive", 90}}},
-                                           {"tick_ms", BenchRuntime::kTick.count()}});
-              }});
-  router.add({"GET", "/api/bench/lock", Role::viewer, "Who holds the operators' control lock.",
-              [control](const Request&) { return json_response(200, control->describe()); }});
-  router.add({"POST", "/api/bench/lock", Role::operator_,
-              "Claim the control lock (operator commands claim it too); 409 while another operator holds it.",
-              [control](const Request& req) {
-                if (!control->claim(req.caller_id)) return locked(*control);
-                return json_response(200, control->describe());
-              }});
-  router.add({"DELETE", "/api/bench/lock", Role::operator_, "Release the control lock; 409 when another operator holds it.",
-              [control](const Request& req) {
-                if (!control->release(req.caller_id)) return locked(*control);
-                return json_response(200, control->describe());
-              }});
+  router.add(answering({"GET", "/api/bench/status", Role::viewer,
+                        "Telemetry of both drives, setpoints, the safety supervisor's phase and trip, recent events.",
+                        [bench](const Request&) { return status_response(*bench->snapshot()); }},
+                       status_schema()));
+  router.add(answering({"GET", "/api/bench/config", Role::viewer, "Limits the bench's setpoints are validated against.",
+                        [max_speed_rpm, max_load_Nm](const Request&) {
+                          return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},
+                                                     {"load_Nm", {{"min", 0}, {"max", max_load_Nm}}},
+                                                     {"angle_deg", {{"min_exclusive", 0}, {"max_exclusive", 90}}},
+                                                     {"tick_ms", BenchRuntime::kTick.count()}});
+                        }},
+                       bench_config_schema()));
+  Route lock_routes[] = {
+      {"GET", "/api/bench/lock", Role::viewer, "Who holds the operators' control lock.",
+       [control](const Request&) { return json_response(200, control->describe()); }},
+      {"POST", "/api/bench/lock", Role::operator_,
+       "Claim the control lock (operator commands claim it too); 409 while another operator holds it.",
+       [control](const Request& req) {
+         if (!control->claim(req.caller_id)) return locked(*control);
+         return json_response(200, control->describe());
+       }},
+      {"DELETE", "/api/bench/lock", Role::operator_, "Release the control lock; 409 when another operator holds it.",
+       [control](const Request& req) {
+         if (!control->release(req.caller_id)) return locked(*control);
+         return json_response(200, control->describe());
+       }}};
+  for (Route& r : lock_routes) router.add(answering(std::move(r), lock_schema()));
   router.add({"POST", "/api/bench/estop", Role::operator_,
               "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once (one request each), "
               "then read back and the disable repeated every tick until both read stopped; latched until reset. Answers "
@@ -348,81 +254,50 @@ void add_api_routes(Router& router, ApiContext ctx) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
                 bench->reset(answer(std::move(reply)));
               })});
+  // The router checks the bodies against these schemas (json_schema.hpp) before the handlers
+  // run: what remains here is the bench's own business.
   router.add({"POST", "/api/bench/enable", Role::operator_,
               "Enable both drives with the current setpoints, or disable them by the ordered stop.",
               AsyncHandler([bench, control](const Request& req, Reply reply) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
-                auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<synbench::Json>(parsed);
-                if (auto r = unknown_fields(doc, {"enabled"})) return reply(*r);
-                if (!doc.contains("enabled")) return reply(bad_field("enabled", "required"));
-                if (!doc["enabled"].is_boolean()) return reply(bad_field("enabled", "must be true or false"));
-                bench->enable(doc["enabled"].get<bool>(), answer(std::move(reply)));
+                bench->enable(req.json["enabled"].get<bool>(), answer(std::move(reply)));
               }),
-              synbench::Json{{"type", "object"}, {"required", {"enabled"}}, {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
+              synbench::Json{{"type", "object"},
+                             {"required", synbench::Json::array({"enabled"})},
+                             {"additionalProperties", false},
+                             {"properties", {{"enabled", {{"type", "boolean"}}}}}}});
   router.add({"POST", "/api/bench/mode", Role::operator_,
               "Choose the estimator and/or PWM scheme manual operation runs with (drives disabled).",
               AsyncHandler([bench, control](const Request& req, Reply reply) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
-                auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<synbench::Json>(parsed);
-                if (auto r = unknown_fields(doc, {"estimator", "pwm"})) return reply(*r);
-                if (doc.empty()) return reply(error_response(400, "bad_field", "give estimator and/or pwm"));
                 app::DriveModeUpdate mode;
-                if (doc.contains("estimator")) {
-                  const auto& v = doc["estimator"];
-                  mode.estimator = v.is_string() ? drivers::parse_estimator(v.get<std::string>()) : std::nullopt;
-                  if (!mode.estimator) return reply(bad_field("estimator", "must be one of " + join(drivers::kEstimatorNames)));
-                }
-                if (doc.contains("pwm")) {
-                  const auto& v = doc["pwm"];
-                  mode.pwm = v.is_string() ? drivers::parse_pwm(v.get<std::string>()) : std::nullopt;
-                  if (!mode.pwm) return reply(bad_field("pwm", "must be one of " + join(drivers::kPwmNames)));
-                }
+                if (req.json.contains("estimator")) mode.estimator = drivers::parse_estimator(req.json["estimator"].get<std::string>());
+                if (req.json.contains("pwm")) mode.pwm = drivers::parse_pwm(req.json["pwm"].get<std::string>());
                 bench->set_mode(mode, answer(std::move(reply)));
               }),
               synbench::Json{{"type", "object"},
                              {"additionalProperties", false},
+                             {"minProperties", 1},
                              {"properties",
                               {{"estimator", {{"type", "string"}, {"enum", drivers::kEstimatorNames}}},
                                {"pwm", {{"type", "string"}, {"enum", drivers::kPwmNames}}}}}}});
   router.add({"POST", "/api/bench/setpoints", Role::operator_,
               "Set speed_rpm, load_Nm and/or angle_deg (omitted fields keep their value).",
-              AsyncHandler([bench, control, max_speed_rpm, max_load_Nm](const Request& req, Reply reply) {
+              AsyncHandler([bench, control](const Request& req, Reply reply) {
                 if (!control->claim(req.caller_id)) return reply(locked(*control));
-                auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return reply(*r);
-                const auto& doc = std::get<synbench::Json>(parsed);
-                if (auto r = unknown_fields(doc, {"speed_rpm", "load_Nm", "angle_deg"})) return reply(*r);
-                if (doc.empty())
-                  return reply(error_response(400, "bad_field", "give at least one of speed_rpm, load_Nm, angle_deg"));
                 app::SetpointsUpdate sp;
-                struct Field {
-                  const char* name;
-                  std::optional<double>* value;
-                  double lo, hi;
-                  bool open;  // exclusive bounds
+                const auto take = [&req](const char* name, std::optional<double>& out) {
+                  if (req.json.contains(name)) out = req.json[name].get<double>();
                 };
-                const Field fields[] = {{"speed_rpm", &sp.speed_rpm, 0, max_speed_rpm, false},
-                                        {"load_Nm", &sp.load_Nm, 0, max_load_Nm, false},
-                                        {"angle_deg", &sp.angle_deg, 0, 90, true}};
-                for (const Field& f : fields) {
-                  if (!doc.contains(f.name)) continue;
-                  const auto& v = doc[f.name];
-                  if (!v.is_number()) return reply(bad_field(f.name, "must be a number"));
-                  const double x = v.get<double>();
-                  const bool ok = std::isfinite(x) && (f.open ? (x > f.lo && x < f.hi) : (x >= f.lo && x <= f.hi));
-                  if (!ok)
-                    return reply(bad_field(f.name, drivers::format_number(x) + " is outside " + (f.open ? "(" : "[") + drivers::format_number(f.lo) + ", " +
-                                                       drivers::format_number(f.hi) + (f.open ? ")" : "]")));
-                  *f.value = x;
-                }
+                take("speed_rpm", sp.speed_rpm);
+                take("load_Nm", sp.load_Nm);
+                take("angle_deg", sp.angle_deg);
                 bench->set_setpoints(sp, answer(std::move(reply)));
               }),
+              // The maxima are the bench's, known when the table is built.
               synbench::Json{{"type", "object"},
                              {"additionalProperties", false},
+                             {"minProperties", 1},
                              {"properties",
                               {{"speed_rpm", number_schema(0, max_speed_rpm, "SynRM speed setpoint")},
                                {"load_Nm", number_schema(0, max_load_Nm, "braking torque of the load")},

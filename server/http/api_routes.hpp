@@ -1,6 +1,7 @@
 // The daemon's REST routes: the table that Router dispatches and the OpenAPI document lists.
-// Each handler validates its input (400 naming the field), calls the bench runtime, and shapes
-// the JSON answer; docs/api.md describes every route.
+// The router checks each body against its route's published schema (400 naming the JSON
+// pointer); a handler calls the bench runtime and shapes the JSON answer, whose schema the
+// OpenAPI document publishes too (response_schemas.hpp). docs/api.md describes every route.
 #pragma once
 
 #include "drivers/json.hpp"
@@ -13,7 +14,6 @@
 #include <optional>
 #include <mutex>
 #include <string>
-#include <variant>
 
 #include "app/bench_runtime.hpp"
 #include "emulator/twin_config.hpp"
@@ -122,10 +122,6 @@ struct ApiContext {
 
 // Adds every route to `router`; the OpenAPI route reads `router` itself when called.
 void add_api_routes(Router& router, ApiContext ctx);
-
-// Request parsing helpers shared by handlers; exposed for tests.
-// The body as a JSON object, or a 400 response naming the problem.
-std::variant<synbench::Json, Response> parse_json_object(const std::string& body);
 
 synbench::Json status_json(const BenchStatus& s);
 // The bench's refusal as an HTTP status: 409 for the bench's state, 502 for a device, 503 while

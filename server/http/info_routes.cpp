@@ -6,6 +6,7 @@
 
 #include "drivers/profile/device_profile.hpp"
 #include "drivers/profile/signal_catalogue.hpp"
+#include "server/http/response_schemas.hpp"
 
 namespace synbench::http {
 namespace {
@@ -68,12 +69,14 @@ synbench::Json profiles_json() {
 }  // namespace
 
 void add_info_routes(Router& router, const BenchRuntime& bench, const emulator::TwinConfig& twin) {
-  router.add({"GET", "/api/whoami", Role::viewer, "The caller's role and identity label (never the token).",
-              [](const Request& req) { return json_response(200, {{"role", role_name(req.caller)}, {"id", req.caller_id}}); }});
+  router.add(answering({"GET", "/api/whoami", Role::viewer, "The caller's role and identity label (never the token).",
+                        [](const Request& req) { return json_response(200, {{"role", role_name(req.caller)}, {"id", req.caller_id}}); }},
+                       whoami_schema()));
   const synbench::Json estimators = estimators_json(twin);
-  router.add({"GET", "/api/estimators", Role::viewer,
-              "Position sources the SynRM drive offers (POST /api/bench/mode selects one), with their speed ranges.",
-              [estimators](const Request&) { return json_response(200, estimators); }});
+  router.add(answering({"GET", "/api/estimators", Role::viewer,
+                        "Position sources the SynRM drive offers (POST /api/bench/mode selects one), with their speed ranges.",
+                        [estimators](const Request&) { return json_response(200, estimators); }},
+                       estimators_schema()));
   router.add({"GET", "/api/devices", Role::viewer, "The bench's devices: role, kind, backend, link, profile.",
               [devices = bench.devices_json()](const Request&) { return json_response(200, devices); }});
   router.add({"GET", "/api/profiles", Role::viewer, "The default device profiles (docs/device-profile.md), as loaded.",

@@ -7,9 +7,12 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
+#include "drivers/json_file.hpp"
 #include "drivers/utf8.hpp"
+#include "server/http/json_schema.hpp"
 #include "server/http/url_text.hpp"
 
 namespace synbench::http {
@@ -107,7 +110,17 @@ bool match_pattern(std::string_view pattern, std::string_view path, std::map<std
   return true;
 }
 
-void Router::add(Route route) { routes_.push_back(std::move(route)); }
+void Router::add(Route route) {
+  if (route.body_checked_by_handler && !route.async_handler)
+    throw std::invalid_argument(route.method + " " + route.pattern + ": a body checked by the handler needs Worker::offloaded");
+  for (const auto* schema : {&route.request_schema, &route.response_schema}) {
+    if (!*schema) continue;
+    if (const auto problems = check_schema(**schema); !problems.empty())
+      throw std::invalid_argument(route.method + " " + route.pattern + ": the " +
+                                  (schema == &route.request_schema ? "request" : "response") + " schema: " + to_string(problems));
+  }
+  routes_.push_back(std::move(route));
+}
 
 std::optional<Identity> Router::identify(std::string_view authorization) const {
   const std::size_t sp = authorization.find(' ');
@@ -141,6 +154,19 @@ std::optional<Response> non_utf8_parameter(const Request& req) {
 }
 
 }  // namespace
+
+std::optional<Response> check_body(const synbench::Json& schema, const std::string& error_code, Request& req) {
+  if (req.body.empty()) return error_response(400, "bad_json", "the request needs a JSON body");
+  // The shared reader: "the body is not valid UTF-8 at byte 12", "the body is nested deeper
+  // than 64 levels at byte 64", "the body is not valid JSON: parse error at line 1, column 9:
+  // ...", a number out of double's range (1e999) included.
+  drivers::JsonParsed parsed = drivers::parse_json_text(req.body);
+  if (!parsed.ok()) return error_response(400, "bad_json", "the body is " + parsed.error);
+  if (const auto errors = validate(schema, parsed.doc); !errors.empty())
+    return error_response(400, error_code, to_string(errors));
+  req.json = std::move(parsed.doc);
+  return std::nullopt;
+}
 
 void Router::dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
                             std::string body, Reply reply) const {
@@ -225,6 +251,8 @@ void Router::route_and_call(const std::string& method, const std::string& target
     req.caller_id = caller->id;
   }
   if (auto bad = non_utf8_parameter(req)) return reply(std::move(*bad));
+  if (route->request_schema && !route->body_checked_by_handler)
+    if (auto bad = check_body(*route->request_schema, route->body_error_code, req)) return reply(std::move(*bad));
   if (route->async_handler) return route->async_handler(req, reply);
   reply(route->handler(req));
 }

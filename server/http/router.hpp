@@ -28,6 +28,8 @@ struct Request {
   std::map<std::string, std::string> query;   // decoded ?a=b&c=d
   std::map<std::string, std::string> params;  // {name} segments of the matched pattern
   std::string body;
+  // The body parsed, once it has passed the route's request_schema (null for a route without one).
+  synbench::Json json;
   Role caller = Role::anyone;                 // the authenticated role, set by the dispatcher
   std::string caller_id;                      // who: a label of the token (never the token), or ""
 };
@@ -68,7 +70,13 @@ struct Route {
   std::string summary;  // one line, for the OpenAPI document and docs/api.md
   Handler handler;             // one of the two
   AsyncHandler async_handler;
-  std::optional<synbench::Json> request_schema;  // JSON Schema of the body, if it takes one
+  // JSON Schema of the body, if it takes one: the router refuses a body that does not conform
+  // (json_schema.hpp) before the handler runs, with `body_error_code`.
+  std::optional<synbench::Json> request_schema;
+  std::string body_error_code = "bad_field";
+  // Set by Worker::offloaded only: the handler runs check_body itself on the worker thread, so
+  // that the io thread never parses a heavy route's (up to 64 KiB) body.
+  bool body_checked_by_handler = false;
   std::optional<synbench::Json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
 };
 
@@ -84,13 +92,16 @@ using Authenticator = std::function<std::optional<Identity>(std::string_view tok
 class Router {
  public:
   explicit Router(Authenticator auth) : auth_(std::move(auth)) {}
+  // Throws std::invalid_argument when a schema of the route uses a keyword the validator does
+  // not implement: what is published must be what is checked.
   void add(Route route);
   const std::vector<Route>& routes() const { return routes_; }
 
   // `target` is the request-target ("/api/x?y=z"); `authorization` the Authorization header
   // (empty when absent). 404 unknown path, 405 wrong method, 401 no or unknown token, 403 role
   // too low; 400 `bad_field` for a path parameter or query parameter that is not UTF-8 after
-  // percent-decoding; otherwise the handler's response, given to `reply` (at once, or from the
+  // percent-decoding; 400 `bad_json` for a body that is not JSON, and the route's
+  // body_error_code for one that fails its request_schema (every problem at its pointer); otherwise the handler's response, given to `reply` (at once, or from the
   // bench thread). Never throws: a handler's exception is a 500, logged on stderr.
   void dispatch_async(const std::string& method, const std::string& target, std::string_view authorization,
                       std::string body, Reply reply) const;
@@ -111,6 +122,11 @@ class Router {
   Authenticator auth_;
   std::vector<Route> routes_;
 };
+
+// `req.body` against a route's request schema: parsed into req.json, or the 400 saying why not
+// (`bad_json` for a missing body or one that is not JSON, else `error_code` listing every
+// problem at its JSON pointer).
+std::optional<Response> check_body(const synbench::Json& schema, const std::string& error_code, Request& req);
 
 // Splits "?a=1&b=x%20y" into decoded pairs; exposed for tests.
 std::map<std::string, std::string> parse_query(std::string_view query);

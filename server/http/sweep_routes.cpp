@@ -14,6 +14,7 @@
 #include "bench/sweep_presets.hpp"
 #include "db/export.hpp"
 #include "server/http/api_routes.hpp"
+#include "server/http/response_schemas.hpp"
 
 namespace synbench::http {
 namespace {
@@ -129,6 +130,33 @@ std::size_t size_bound(const bench::SweepPlan& p) {
   return pairs * std::max<std::size_t>(1, p.angles_deg.size()) * std::max<std::size_t>(1, p.configurations.size());
 }
 
+// A plan's top level as the OpenAPI document publishes it and the router checks it;
+// bench::parse_sweep_plan checks the rest (and unknown members: "_"-comments are allowed, which
+// additionalProperties cannot say), each problem at its pointer.
+synbench::Json plan_schema() {
+  const synbench::Json object = {{"type", "object"}};
+  return {{"type", "object"},
+          {"description", "a sweep plan, docs/sweep-plan.md"},
+          {"properties",
+           {{"name", {{"type", "string"}}},
+            {"preset", {{"oneOf", synbench::Json::array({{{"type", "string"}}, object})}, {"description", "a preset's name, or {\"name\": ..., options}"}}},
+            {"dimensions", object},
+            {"order", {{"type", "string"}, {"description", "e.g. speed-load-config-angle, outermost first"}}},
+            {"mode", {{"type", "string"}, {"enum", synbench::Json::array({"grid", "adaptive"})}}},
+            {"adaptive", object},
+            {"gate", object},
+            {"window_s", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 3600}}},
+            {"thermal", object},
+            {"limits", object},
+            {"notes", {{"type", "array"}, {"items", {{"type", "string"}}}}}}}};
+}
+
+// A route whose body is a plan: a body the schema refuses is a `bad_plan`, as the parser's are.
+Route plan_route(Route r) {
+  r.body_error_code = "bad_plan";
+  return r;
+}
+
 // A viewer may estimate plans up to this size; an operator up to the plan parser's own limit.
 constexpr std::size_t kViewerEstimatePoints = 100000;
 
@@ -179,13 +207,11 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   runtime->sweep_action(*id, a, answer(std::move(reply)));
                 })});
   }
-  router.add({"POST", "/api/sweeps", Role::operator_,
+  router.add(plan_route({"POST", "/api/sweeps", Role::operator_,
               "Create a sweep from a plan (docs/sweep-plan.md): 201 with its id, state created.",
               [db, lock, bench_config](const Request& req) {
                 if (!lock->claim(req.caller_id)) return locked(*lock);
-                auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return *r;
-                auto plan = bench::parse_sweep_plan(std::get<synbench::Json>(parsed));
+                auto plan = bench::parse_sweep_plan(req.json);
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 db::SweepMeta meta;
                 meta.name = plan.plan->name.empty() ? "sweep" : plan.plan->name;
@@ -198,15 +224,16 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 if (!s) return db_error(s.error());
                 return json_response(201, sweep_json(*s, true));
               },
-              synbench::Json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
-  router.add({"GET", "/api/sweeps", Role::viewer, "Run history: every sweep in the store, by id.", [db](const Request&) {
+              plan_schema()}));
+  router.add(answering({"GET", "/api/sweeps", Role::viewer, "Run history: every sweep in the store, by id.", [db](const Request&) {
                 auto list = db->list_sweeps();
                 if (!list) return db_error(list.error());
                 synbench::Json out = synbench::Json::array();
                 for (const auto& s : *list) out.push_back(sweep_json(s, false));
                 return json_response(200, out);
-              }});
-  router.add({"GET", "/api/sweeps/{id}", Role::viewer, "One sweep: state, progress, timestamps, its plan.",
+              }},
+              {{"type", "array"}, {"items", sweep_schema(false)}}));
+  router.add(answering({"GET", "/api/sweeps/{id}", Role::viewer, "One sweep: state, progress, timestamps, its plan.",
               [db](const Request& req) {
                 Response err;
                 const auto id = sweep_id(req, err);
@@ -214,8 +241,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 auto s = db->get_sweep(*id);
                 if (!s) return db_error(s.error());
                 return json_response(200, sweep_json(*s, true));
-              }});
-  router.add({"GET", "/api/sweeps/{id}/points", Role::viewer,
+              }},
+              sweep_schema(true)));
+  router.add(answering({"GET", "/api/sweeps/{id}/points", Role::viewer,
               "A sweep's stored points (docs/record.md): JSON, or CSV with ?format=csv; ?offset=&limit= pages them "
               "(at most 10000 a page; X-Total-Count gives the total).",
               worker.offload([db_path](const Request& req) {
@@ -243,8 +271,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 }
                 r.headers.emplace_back("X-Total-Count", std::to_string(all.size()));
                 return r;
-              })});
-  router.add({"GET", "/api/sweeps/{id}/analysis", Role::viewer,
+              })},
+              points_schema()));
+  router.add(answering({"GET", "/api/sweeps/{id}/analysis", Role::viewer,
               "Analysis of a sweep's stored points (docs/analysis.md): JSON, or the curves as CSV with ?format=csv; "
               "?reference=ESTIMATOR/PWM (default encoder/capwm) for the deltas.",
               worker.offload([db_path](const Request& req) {
@@ -278,8 +307,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   r.body = dump_json(bench::to_json(analysis));
                 }
                 return r;
-              })});
-  router.add({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
+              })},
+              analysis_schema()));
+  router.add(answering({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
               [](const Request&) {
                 synbench::Json out = synbench::Json::array();
                 const auto add = [&out](std::string_view name, const char* description, const bench::SweepPlan& p) {
@@ -294,13 +324,12 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 add(bench::kIecPreset, "IEC 61800-9-2 drive operating points (speed %, torque %) at 40..76 deg step 2",
                     bench::iec_61800_9_2_plan());
                 return json_response(200, out);
-              }});
-  router.add({"POST", "/api/sweeps/estimate", Role::viewer,
+              }},
+              presets_schema()));
+  router.add(worker.offloaded(answering(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
               "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
-              worker.offload([](const Request& req) {
-                auto parsed = parse_json_object(req.body);
-                if (auto* r = std::get_if<Response>(&parsed)) return *r;
-                auto plan = bench::parse_sweep_plan(std::get<synbench::Json>(parsed));
+              [](const Request& req) {
+                auto plan = bench::parse_sweep_plan(req.json);
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
                 if (req.caller != Role::operator_ && size_bound(*plan.plan) > kViewerEstimatePoints)
                   return error_response(413, "too_large", "a viewer may estimate plans of at most " +
@@ -310,8 +339,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 out["duration_s"] = e.bench_time_s;
                 out["plan"] = bench::to_json(*plan.plan);
                 return json_response(200, out);
-              }),
-              synbench::Json{{"type", "object"}, {"description", "a sweep plan, docs/sweep-plan.md"}}});
+              },
+              plan_schema()}),
+                       estimate_schema(true))));
 }
 
 }  // namespace synbench::http

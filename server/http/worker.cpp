@@ -2,6 +2,7 @@
 #include "server/http/worker.hpp"
 
 #include <exception>
+#include <stdexcept>
 
 #include <boost/asio/post.hpp>
 
@@ -27,6 +28,20 @@ AsyncHandler Worker::offload(Handler handler) {
       reply(std::move(r));
     });
   };
+}
+
+Route Worker::offloaded(Route route) {
+  if (!route.handler) throw std::invalid_argument(route.method + " " + route.pattern + ": Worker::offloaded needs a synchronous handler");
+  route.async_handler = offload([handler = std::move(route.handler), schema = route.request_schema,
+                                 code = route.body_error_code](const Request& req) {
+    if (!schema) return handler(req);
+    Request checked = req;
+    if (auto bad = check_body(*schema, code, checked)) return std::move(*bad);
+    return handler(checked);
+  });
+  route.handler = nullptr;
+  route.body_checked_by_handler = true;
+  return route;
 }
 
 void Worker::post(std::function<void()> job) { boost::asio::post(pool_, std::move(job)); }

@@ -23,6 +23,10 @@ class Worker {
 
   // `handler` as a route handler that runs on the worker thread.
   AsyncHandler offload(Handler handler);
+  // `route` (with a synchronous handler) run on the worker thread, its body check
+  // (check_body against its request_schema) included: a heavy route's body is never parsed on
+  // the io thread, nor at all when the queue is full.
+  Route offloaded(Route route);
   // Runs `job` on the worker thread (its set-up, e.g. the thread's own store connection).
   void post(std::function<void()> job);
   // Stops taking work and waits for what runs.

@@ -246,7 +246,7 @@ def test_operator(d, viewer):
         check(r and r["status"] == 200, "operator POST %s over WS -> 200" % path)
     ws.send(json.dumps({"op": "request", "id": "bad", "method": "POST", "path": "/api/bench/setpoints", "body": {"speed_rpm": -1}}))
     r = recv_until(ws, lambda m: m["type"] == "reply" and m["id"] == "bad")
-    check(r and r["status"] == 400 and r["body"]["error"]["message"].startswith("speed_rpm"), "REST validation applies over WS")
+    check(r and r["status"] == 400 and r["body"]["error"]["message"].startswith("/speed_rpm"), "REST validation applies over WS")
     seen = {}
     recv_until(watcher, lambda m: seen.setdefault(m["type"] + str(m.get("kind", m.get("enabled"))), m) and False, timeout_s=2)
     check("stateTrue" in seen, "a state message when the bench is enabled")

@@ -1,12 +1,16 @@
 // The REST routes on the real-time twin, called through the Router without a socket: every
-// mutating route needs an operator, setpoints are validated naming the field, and the twin
-// follows a speed setpoint.
+// mutating route needs an operator, bodies are refused at their JSON pointer by the published
+// schemas, the live answers conform to the published answer schemas, and the twin follows a
+// speed setpoint.
 #include "server/http/api_routes.hpp"
 
 #include "app/bench_backend.hpp"
+#include "drivers/profile/number_format.hpp"
 #include "server/cli/bench_setup.hpp"
+#include "server/http/json_schema.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -60,6 +64,71 @@ TEST_F(Api, SetpointsAreValidatedNamingTheField) {
   EXPECT_EQ(bad.status, 400);
   EXPECT_NE(bad.body.find("bad_json"), std::string::npos);
   EXPECT_NE(bad.body.find("column"), std::string::npos);
+}
+
+std::string error_text(const Response& r) {
+  const auto doc = synbench::Json::parse(r.body);
+  return doc["error"]["code"].get<std::string>() + " " + doc["error"]["message"].get<std::string>();
+}
+
+TEST_F(Api, EveryBodyRouteRefusesABadBodyAtItsPointer) {
+  const auto max_rpm = drivers::format_number(bench.description().max_speed_rpm);
+  const std::pair<const char*, const char*> cases[][2] = {
+      {{"/api/bench/enable", R"({"enabled": 1})"}, {"", "bad_field /enabled: must be true or false"}},
+      {{"/api/bench/enable", R"({})"}, {"", "bad_field /enabled: required field is missing"}},
+      {{"/api/bench/enable", R"({"enabled": true, "now": 1})"}, {"", "bad_field /now: unknown field (expected: enabled)"}},
+      {{"/api/bench/mode", R"({"pwm": "svpwm"})"}, {"", "bad_field /pwm: must be one of capwm, aspwm (got 'svpwm')"}},
+      {{"/api/bench/mode", R"({})"}, {"", "bad_field (document): give at least 1 of estimator, pwm"}},
+      {{"/api/bench/setpoints", R"({"angle_deg": 90})"}, {"", "bad_field /angle_deg: 90 is outside (0, 90)"}},
+      {{"/api/bench/setpoints", R"({"load_Nm": -1, "angle_deg": "x"})"},
+       {"", "bad_field /load_Nm: -1 is outside [0, "}},
+      {{"/api/bench/setpoints", R"({})"}, {"", "bad_field (document): give at least 1 of speed_rpm, load_Nm, angle_deg"}},
+      {{"/api/bench/setpoints", R"(5)"}, {"", "bad_field (document): must be an object"}},
+  };
+  for (const auto& c : cases) {
+    const auto r = post(c[0].first, c[0].second);
+    EXPECT_EQ(r.status, 400) << c[0].first << " " << c[0].second;
+    EXPECT_EQ(error_text(r).rfind(c[1].second, 0), 0u) << c[0].first << " " << c[0].second << ": " << error_text(r);
+  }
+  EXPECT_EQ(error_text(post("/api/bench/setpoints", R"({"speed_rpm": 1e6})")),
+            "bad_field /speed_rpm: 1000000 is outside [0, " + max_rpm + "]");
+  EXPECT_NE(error_text(post("/api/bench/setpoints", R"({"load_Nm": -1, "angle_deg": "x"})")).find("; /angle_deg: must be a number"),
+            std::string::npos);
+  // A refused body claims nothing: another operator may still take the lock.
+  EXPECT_EQ(post("/api/bench/lock", "", "op2").status, 200);
+  // Every route that reads a body publishes its schema.
+  for (const auto& r : router.routes()) {
+    if (r.pattern == "/api/bench/enable" || r.pattern == "/api/bench/mode" || r.pattern == "/api/bench/setpoints") {
+      EXPECT_TRUE(r.request_schema) << r.pattern;
+    }
+  }
+}
+
+// The answers of the real handlers against the schemas the OpenAPI document publishes, with the
+// bench idle and after an E-stop (trip, disable report filled in).
+TEST_F(Api, LiveAnswersConformToThePublishedSchemas) {
+  const auto doc = synbench::Json::parse(router.dispatch("GET", "/api/openapi.json", "", "").body);
+  const auto check_all = [&](const std::string& when) {
+    std::size_t checked = 0;
+    for (const auto& [pattern, methods] : doc["paths"].items())
+      for (const auto& [method, op] : methods.items()) {
+        const auto& ok = op["responses"]["200"];
+        if (!ok.contains("content")) continue;
+        std::string upper = method;
+        for (auto& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+        const auto answer = router.dispatch(upper, pattern, "Bearer op", "");
+        ASSERT_EQ(answer.status, 200) << upper << " " << pattern << ": " << answer.body;
+        const auto errors = validate(ok["content"]["application/json"]["schema"], synbench::Json::parse(answer.body));
+        EXPECT_TRUE(errors.empty()) << when << ": " << upper << " " << pattern << ": " << to_string(errors);
+        ++checked;
+      }
+    EXPECT_EQ(checked, 8u) << when;  // status, health, config, lock x3, whoami, estimators
+  };
+  check_all("idle");
+  ASSERT_EQ(post("/api/bench/estop", "").status, 200);
+  const auto status = synbench::Json::parse(router.dispatch("GET", "/api/bench/status", "Bearer view", "").body);
+  EXPECT_FALSE(status["supervisor"]["disable"].is_null());
+  check_all("after an E-stop");
 }
 
 TEST_F(Api, TwinFollowsSpeedSetpointAndEstopLatches) {

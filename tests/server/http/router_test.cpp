@@ -1,5 +1,8 @@
-// Router: matching, 404/405, bearer auth (401/403), handler errors, the OpenAPI document.
+// Router: matching, 404/405, bearer auth (401/403), handler errors, bodies checked against the
+// route's request schema, the OpenAPI document.
 #include "server/http/router.hpp"
+
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +25,17 @@ Router make_router() {
          AsyncHandler([](const Request&, Reply) { throw std::runtime_error("kaput \xFF"); })});
   r.add({"GET", "/api/echo", Role::anyone, "echoes bytes into JSON",
          [](const Request&) { return json_response(200, {{"text", std::string("a\xFF" "b")}}); }});
+  // The handler answers with the parsed body it was given.
+  r.add({"POST", "/api/things", Role::operator_, "takes a body",
+         [](const Request& q) { return json_response(200, {{"got", q.json}}); },
+         synbench::Json{{"type", "object"},
+                        {"required", synbench::Json::array({"n"})},
+                        {"additionalProperties", false},
+                        {"properties", {{"n", {{"type", "integer"}, {"minimum", 1}, {"maximum", 9}}}, {"a/b", {{"type", "string"}}}}}}});
+  Route plan{"POST", "/api/plans", Role::viewer, "a body whose own error code is bad_plan",
+             [](const Request&) { return json_response(200, {{"ok", true}}); }, synbench::Json{{"type", "object"}}};
+  plan.body_error_code = "bad_plan";
+  r.add(std::move(plan));
   return r;
 }
 
@@ -110,6 +124,54 @@ TEST(Router, BytesThatAreNotUtf8NeverBreakTheAnswer) {
   EXPECT_EQ(r.dispatch("GET", "/api/things/%ff", "", "").status, 401);
 }
 
+TEST(Router, BodiesAreCheckedAgainstTheRequestSchemaBeforeTheHandler) {
+  const Router r = make_router();
+  const auto ok = r.dispatch("POST", "/api/things", "Bearer op", R"({"n": 3})");
+  ASSERT_EQ(ok.status, 200) << ok.body;
+  EXPECT_EQ(body(ok)["got"]["n"], 3);
+  const auto message = [&](const std::string& text) {
+    const auto res = r.dispatch("POST", "/api/things", "Bearer op", text);
+    EXPECT_EQ(res.status, 400) << text;
+    return body(res)["error"]["code"].get<std::string>() + " " + body(res)["error"]["message"].get<std::string>();
+  };
+  EXPECT_EQ(message(R"({"n": 10})"), "bad_field /n: 10 is outside [1, 9]");
+  EXPECT_EQ(message(R"({"n": "3"})"), "bad_field /n: must be an integer");
+  EXPECT_EQ(message(R"({})"), "bad_field /n: required field is missing");
+  EXPECT_EQ(message(R"({"n": 1, "a/b": 2, "x": 0})"),
+            "bad_field /a~1b: must be a string; /x: unknown field (expected: n, a/b)");
+  EXPECT_EQ(message(R"([1])"), "bad_field (document): must be an object");
+  EXPECT_EQ(message(""), "bad_json the request needs a JSON body");
+  EXPECT_NE(message(R"({"n": )").find("bad_json the body is not valid JSON"), std::string::npos);
+  EXPECT_NE(message("{\"n\": \"\xFF\"}").find("bad_json the body is not valid UTF-8"), std::string::npos);
+  // A route's own code for a body it refuses.
+  const auto plan = r.dispatch("POST", "/api/plans", "Bearer view", "3");
+  EXPECT_EQ(plan.status, 400);
+  EXPECT_EQ(body(plan)["error"]["code"], "bad_plan");
+  // Auth first: a caller without the role learns nothing about the body.
+  EXPECT_EQ(r.dispatch("POST", "/api/things", "", "nonsense").status, 401);
+  EXPECT_EQ(r.dispatch("POST", "/api/things", "Bearer view", "nonsense").status, 403);
+}
+
+TEST(Router, ARouteWhoseSchemaUsesAnUnknownKeywordIsRefused) {
+  Router r([](std::string_view) { return std::nullopt; });
+  const auto handler = [](const Request&) { return json_response(200, synbench::Json::object()); };
+  EXPECT_THROW(r.add({"POST", "/x", Role::anyone, "x", handler, synbench::Json{{"type", "object"}, {"patternProperties", {}}}}),
+               std::invalid_argument);
+  Route answer{"GET", "/y", Role::anyone, "y", handler};
+  answer.response_schema = synbench::Json{{"type", "string"}, {"format", "date-time"}};
+  try {
+    r.add(std::move(answer));
+    ADD_FAILURE() << "a response schema with format was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("GET /y: the response schema: /format: keyword not implemented"), std::string::npos) << e.what();
+  }
+  // Only Worker::offloaded may leave the body check to the handler (it runs it on the worker).
+  Route unchecked{"POST", "/z", Role::anyone, "z", handler, synbench::Json{{"type", "object"}}};
+  unchecked.body_checked_by_handler = true;
+  EXPECT_THROW(r.add(std::move(unchecked)), std::invalid_argument);
+  EXPECT_TRUE(r.routes().empty());
+}
+
 TEST(Router, OpenApiListsEveryRouteWithRoleAndPathParameters) {
   const Router r = make_router();
   const auto doc = r.openapi("t", "1");
@@ -122,6 +184,9 @@ TEST(Router, OpenApiListsEveryRouteWithRoleAndPathParameters) {
   EXPECT_EQ(start["parameters"][0]["name"], "id");
   EXPECT_TRUE(start["responses"].contains("401"));
   EXPECT_TRUE(doc["paths"]["/api/open"]["get"]["security"].empty());
+  // The published request schema is the one the router checks.
+  EXPECT_EQ(doc["paths"]["/api/things"]["post"]["requestBody"]["content"]["application/json"]["schema"],
+            r.routes()[6].request_schema.value());
 }
 
 }  // namespace
