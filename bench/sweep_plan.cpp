@@ -137,7 +137,7 @@ std::string_view name(SweepDimension d) {
   return "?";
 }
 
-std::string_view name(SweepMode m) { return m == SweepMode::grid ? "grid" : "adaptive"; }
+std::string_view name(SweepMode m) { return kSweepModeNames[static_cast<std::size_t>(m)]; }
 
 std::string order_name(const std::array<SweepDimension, 4>& order) {
   std::string s;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "drivers/json_fwd.hpp"
+#include "drivers/json_reader.hpp"
 
 #include <array>
 #include <cstddef>
@@ -42,6 +43,7 @@ struct OperatingPoint {
 
 enum class SweepDimension { speed, load, config, angle };
 enum class SweepMode { grid, adaptive };
+inline constexpr std::array<std::string_view, 2> kSweepModeNames{"grid", "adaptive"};  // by value
 
 // The steady-state gate of every point: bands and slopes (SteadyStateBands), the least settling
 // time after the load is applied, and the timeout after which the point is measured anyway and
@@ -100,13 +102,10 @@ struct SweepPlan {
   bool operator==(const SweepPlan&) const = default;
 };
 
-// One problem in a plan document: RFC 6901 JSON pointer ("" for the whole document) and reason.
-struct SweepPlanError {
-  std::string json_pointer;
-  std::string reason;
-};
-// "/dimensions/speed_rpm/1: must be > 0"
-std::string to_string(const SweepPlanError& e);
+// One problem in a plan document: RFC 6901 JSON pointer ("" for the whole document) and
+// reason; drivers::to_string(e) gives "/dimensions/speed_rpm/1: must be > 0".
+using SweepPlanError = drivers::JsonError;
+using drivers::to_string;
 
 struct SweepPlanParseResult {
   std::optional<SweepPlan> plan;        // set exactly when errors is empty

@@ -18,21 +18,14 @@ namespace {
 
 using json = synbench::Json;
 
+using drivers::JsonNode;
+using drivers::JsonReader;
+using drivers::non_negative;
+using drivers::positive;
+using Check = drivers::NumberCheck;
+
 constexpr std::size_t kMaxDimensionValues = 10000;  // a range with more is a typo, not a plan
 constexpr std::size_t kMaxPoints = 1000000;
-
-// JSON keys starting with '_' are comments, as in config/twin.json and the device profiles.
-bool is_comment(const std::string& key) { return !key.empty() && key.front() == '_'; }
-
-std::string token(std::string_view key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
 
 std::string num(double v) {
   char buf[32];
@@ -42,18 +35,15 @@ std::string num(double v) {
 
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
-// A value check: empty string when fine, else the reason.
-using Check = std::function<std::string(double)>;
-
-Check positive() {
-  return [](double v) { return v > 0 ? std::string() : "must be > 0"; };
-}
-Check non_negative() {
-  return [](double v) { return v >= 0 ? std::string() : "must be >= 0"; };
-}
 Check within(double lo, double hi, const char* unit) {
   return [=](double v) {
     return v >= lo && v <= hi ? std::string() : "must be within [" + num(lo) + ", " + num(hi) + "] " + unit;
+  };
+}
+// (lo, hi]: a duration or a tolerance.
+Check above_at_most(double lo, double hi, const char* unit) {
+  return [=](double v) {
+    return v > lo && v <= hi ? std::string() : "must be within (" + num(lo) + ", " + num(hi) + "] " + unit;
   };
 }
 Check positive_at_most(double hi, const std::string& what) {
@@ -76,150 +66,74 @@ Check angle_check() {
   };
 }
 
-class Parser {
- public:
-  std::vector<SweepPlanError> errors;
-
-  void fail(std::string ptr, std::string reason) { errors.push_back({std::move(ptr), std::move(reason)}); }
-
-  bool object(const json& v, const std::string& ptr) {
-    if (v.is_object()) return true;
-    fail(ptr, "must be a JSON object");
-    return false;
-  }
-
-  void reject_unknown(const json& obj, const std::string& ptr, std::initializer_list<std::string_view> known) {
-    for (const auto& [key, value] : obj.items()) {
-      if (is_comment(key)) continue;
-      if (std::find(known.begin(), known.end(), key) == known.end()) fail(ptr + "/" + token(key), "unknown field");
-    }
-  }
-
-  // A number at obj[key]: nothing when absent or invalid (invalid is reported).
-  std::optional<double> number(const json& obj, const std::string& ptr, const char* key, const Check& check) {
-    const auto it = obj.find(key);
-    if (it == obj.end()) return std::nullopt;
-    return number_value(*it, ptr + "/" + key, check);
-  }
-
-  std::optional<double> number_value(const json& v, const std::string& ptr, const Check& check) {
-    if (!v.is_number() || !std::isfinite(v.get<double>())) {
-      fail(ptr, "must be a finite number");
-      return std::nullopt;
-    }
-    const double x = v.get<double>();
-    if (check) {
-      if (auto reason = check(x); !reason.empty()) {
-        fail(ptr, reason);
-        return std::nullopt;
-      }
-    }
-    return x;
-  }
-
-  // Overwrites `out` when obj[key] is present and valid.
-  void set(const json& obj, const std::string& ptr, const char* key, double& out, const Check& check) {
-    if (auto v = number(obj, ptr, key, check)) out = *v;
-  }
-
-  void set_bool(const json& obj, const std::string& ptr, const char* key, bool& out) {
-    const auto it = obj.find(key);
-    if (it == obj.end()) return;
-    if (!it->is_boolean()) {
-      fail(ptr + "/" + key, "must be true or false");
-      return;
-    }
-    out = it->get<bool>();
-  }
-
-  // A dimension: a non-empty list of numbers or a range {from, to, step}. Every value is checked;
-  // duplicates are rejected (they would measure a point twice under two indices).
-  std::optional<std::vector<double>> dimension(const json& v, const std::string& ptr, const Check& check) {
-    if (v.is_array()) return list(v, ptr, check);
-    if (v.is_object()) return range(v, ptr, check);
-    fail(ptr, "must be a list of numbers or a range {\"from\", \"to\", \"step\"}");
-    return std::nullopt;
-  }
-
-  std::optional<std::vector<double>> list(const json& v, const std::string& ptr, const Check& check) {
-    if (v.empty()) {
-      fail(ptr, "must not be empty");
-      return std::nullopt;
-    }
-    if (v.size() > kMaxDimensionValues) {
-      fail(ptr, "has " + std::to_string(v.size()) + " values; at most " + std::to_string(kMaxDimensionValues));
-      return std::nullopt;
-    }
-    std::vector<double> out;
-    bool ok = true;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const std::string p = ptr + "/" + std::to_string(i);
-      const auto x = number_value(v[i], p, check);
-      if (!x) {
-        ok = false;
-        continue;
-      }
-      for (std::size_t j = 0; j < out.size(); ++j) {
-        if (std::fabs(out[j] - *x) <= 1e-9 * std::max(1.0, std::fabs(*x))) {
-          fail(p, "duplicate of " + ptr + "/" + std::to_string(j) + " (" + num(*x) + ")");
-          ok = false;
-        }
-      }
-      out.push_back(*x);
-    }
-    if (!ok) return std::nullopt;
-    return out;
-  }
-
-  std::optional<std::vector<double>> range(const json& v, const std::string& ptr, const Check& check) {
-    reject_unknown(v, ptr, {"from", "to", "step"});
-    const std::size_t before = errors.size();
-    for (const char* key : {"from", "to", "step"})
-      if (!v.contains(key)) fail(ptr + "/" + key, "required field is missing");
-    const auto from = number(v, ptr, "from", check);
-    const auto to = number(v, ptr, "to", check);
-    const auto step = number(v, ptr, "step", positive());
-    if (errors.size() != before || !from || !to || !step) return std::nullopt;
-    if (*from > *to) {
-      fail(ptr + "/to", "must be >= from (" + num(*from) + ")");
-      return std::nullopt;
-    }
-    const double steps = (*to - *from) / *step;
-    if (steps + 1 > static_cast<double>(kMaxDimensionValues)) {
-      fail(ptr + "/step", "gives " + num(std::floor(steps) + 1) + " values; at most " +
-                              std::to_string(kMaxDimensionValues));
-      return std::nullopt;
-    }
-    if (std::fabs(steps - std::round(steps)) > 1e-6) {
-      const auto values = inclusive_range(*from, *to, *step);
-      fail(ptr + "/to", num(*to) + " is not reached from " + num(*from) + " in whole steps of " + num(*step) +
-                            " (the last value would be " + num(values.back()) + ")");
-      return std::nullopt;
-    }
-    return inclusive_range(*from, *to, *step);
-  }
-
-  std::optional<std::string> string(const json& obj, const std::string& ptr, const char* key) {
-    const auto it = obj.find(key);
-    if (it == obj.end()) return std::nullopt;
-    if (!it->is_string()) {
-      fail(ptr + "/" + key, "must be a string");
-      return std::nullopt;
-    }
-    return it->get<std::string>();
-  }
-};
-
-std::string estimator_list() {
-  std::string s;
-  for (auto n : drivers::kEstimatorNames) s += (s.empty() ? "" : ", ") + std::string(n);
-  return s;
+// Overwrites `out` when the node is present and valid.
+void set(const JsonNode& n, double& out, const Check& check) {
+  if (auto v = n.number(check)) out = *v;
+}
+// Same for an optional value, which null clears.
+void set_or_clear(const JsonNode& n, std::optional<double>& out, const Check& check) {
+  if (n.is_null()) out.reset();
+  else if (auto v = n.number(check)) out = *v;
 }
 
-std::string pwm_list() {
-  std::string s;
-  for (auto n : drivers::kPwmNames) s += (s.empty() ? "" : ", ") + std::string(n);
-  return s;
+bool near(double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(1.0, std::fabs(b)); }
+
+std::optional<std::vector<double>> range(const JsonNode& v, const Check& check);
+
+// A dimension: a non-empty list of numbers or a range {from, to, step}. Every value is checked;
+// duplicates are rejected (they would measure a point twice under two indices).
+std::optional<std::vector<double>> dimension(const JsonNode& v, const Check& check) {
+  if (v.present() && v.json().is_object()) return range(v, check);
+  const auto items = v.list("must be a list of numbers or a range {\"from\", \"to\", \"step\"}", true);
+  if (!items) return std::nullopt;
+  if (items->size() > kMaxDimensionValues) {
+    v.fail("has " + std::to_string(items->size()) + " values; at most " + std::to_string(kMaxDimensionValues));
+    return std::nullopt;
+  }
+  std::vector<double> out;
+  bool ok = true;
+  for (const JsonNode& item : *items) {
+    const auto x = item.number(check);
+    if (!x) {
+      ok = false;
+      continue;
+    }
+    for (std::size_t j = 0; j < out.size(); ++j) {
+      if (near(out[j], *x)) {
+        item.fail("duplicate of " + v.pointer() + "/" + std::to_string(j) + " (" + num(*x) + ")");
+        ok = false;
+      }
+    }
+    out.push_back(*x);
+  }
+  if (!ok) return std::nullopt;
+  return out;
+}
+
+std::optional<std::vector<double>> range(const JsonNode& v, const Check& check) {
+  JsonReader& r = v.reader();
+  v.reject_unknown({"from", "to", "step"});
+  const std::size_t before = r.count();
+  const auto from = v["from"].required().number(check);
+  const auto to = v["to"].required().number(check);
+  const auto step = v["step"].required().number(positive());
+  if (r.count() != before || !from || !to || !step) return std::nullopt;
+  if (*from > *to) {
+    v["to"].fail("must be >= from (" + num(*from) + ")");
+    return std::nullopt;
+  }
+  const double steps = (*to - *from) / *step;
+  if (steps + 1 > static_cast<double>(kMaxDimensionValues)) {
+    v["step"].fail("gives " + num(std::floor(steps) + 1) + " values; at most " + std::to_string(kMaxDimensionValues));
+    return std::nullopt;
+  }
+  if (std::fabs(steps - std::round(steps)) > 1e-6) {
+    const auto values = inclusive_range(*from, *to, *step);
+    v["to"].fail(num(*to) + " is not reached from " + num(*from) + " in whole steps of " + num(*step) +
+                 " (the last value would be " + num(values.back()) + ")");
+    return std::nullopt;
+  }
+  return inclusive_range(*from, *to, *step);
 }
 
 std::optional<SweepDimension> parse_dimension(std::string_view s) {
@@ -229,112 +143,80 @@ std::optional<SweepDimension> parse_dimension(std::string_view s) {
 }
 
 // "preset": "thesis-grid" or {"name": "iec-61800-9-2", "rated_speed_rpm": ..., ...}
-SweepPlan preset_plan(Parser& p, const json& v) {
-  const std::string ptr = "/preset";
+SweepPlan preset_plan(const JsonNode& v) {
   std::string preset;
-  const json* options = nullptr;
-  if (v.is_string()) {
-    preset = v.get<std::string>();
-  } else if (v.is_object()) {
-    options = &v;
-    if (auto s = p.string(v, ptr, "name")) preset = *s;
-    else if (!v.contains("name")) p.fail(ptr + "/name", "required field is missing");
+  const bool options = v.present() && v.json().is_object();
+  if (v.json().is_string()) {
+    preset = v.json().get<std::string>();
+  } else if (options) {
+    preset = v["name"].required().text().value_or("");
   } else {
-    p.fail(ptr, "must be a preset name or an object {\"name\": ...}");
+    v.fail("must be a preset name or an object {\"name\": ...}");
     return SweepPlan{};
   }
-  const std::string name_ptr = options ? ptr + "/name" : ptr;
   if (preset == kThesisGridPreset) {
-    if (options) p.reject_unknown(*options, ptr, {"name"});
+    if (options) v.reject_unknown({"name"});
     return thesis_grid_plan();
   }
   if (preset == kIecPreset) {
     IecPresetOptions o;
     if (options) {
-      p.reject_unknown(*options, ptr, {"name", "rated_speed_rpm", "rated_torque_Nm", "zero_speed_rpm"});
-      p.set(*options, ptr, "rated_speed_rpm", o.rated_speed_rpm, positive());
-      p.set(*options, ptr, "rated_torque_Nm", o.rated_torque_Nm, positive());
-      p.set(*options, ptr, "zero_speed_rpm", o.zero_speed_rpm, non_negative());
+      v.reject_unknown({"name", "rated_speed_rpm", "rated_torque_Nm", "zero_speed_rpm"});
+      set(v["rated_speed_rpm"], o.rated_speed_rpm, positive());
+      set(v["rated_torque_Nm"], o.rated_torque_Nm, positive());
+      set(v["zero_speed_rpm"], o.zero_speed_rpm, non_negative());
     }
     return iec_61800_9_2_plan(o);
   }
-  if (!preset.empty() || v.is_string()) {
-    std::string known;
-    for (auto n : kPresetNames) known += (known.empty() ? "" : ", ") + std::string(n);
-    p.fail(name_ptr, "unknown preset " + in_quotes(preset) + " (expected " + known + ")");
-  }
+  if (!preset.empty() || !options)
+    (options ? v["name"] : v).fail(JsonNode::unknown_choice("preset", preset, JsonNode::names_list(kPresetNames)));
   return SweepPlan{};
 }
 
-void parse_limits(Parser& p, const json& doc, SweepLimits& l) {
-  const auto it = doc.find("limits");
-  if (it == doc.end()) return;
-  const std::string ptr = "/limits";
-  if (!p.object(*it, ptr)) return;
-  const json& v = *it;
-  p.reject_unknown(v, ptr, {"max_speed_rpm", "max_load_Nm", "max_current_A", "max_udc_V", "min_udc_V", "max_temp_C"});
-  p.set(v, ptr, "max_speed_rpm", l.max_speed_rpm, positive());
-  p.set(v, ptr, "max_load_Nm", l.max_load_Nm, positive());
-  p.set(v, ptr, "max_current_A", l.max_current_A, positive());
-  p.set(v, ptr, "max_udc_V", l.max_udc_V, positive());
-  p.set(v, ptr, "min_udc_V", l.min_udc_V, non_negative());
-  p.set(v, ptr, "max_temp_C", l.max_temp_C, within(-40, 250, "degC"));
+void parse_limits(const JsonNode& v, SweepLimits& l) {
+  if (!v.object()) return;
+  v.reject_unknown({"max_speed_rpm", "max_load_Nm", "max_current_A", "max_udc_V", "min_udc_V", "max_temp_C"});
+  set(v["max_speed_rpm"], l.max_speed_rpm, positive());
+  set(v["max_load_Nm"], l.max_load_Nm, positive());
+  set(v["max_current_A"], l.max_current_A, positive());
+  set(v["max_udc_V"], l.max_udc_V, positive());
+  set(v["min_udc_V"], l.min_udc_V, non_negative());
+  set(v["max_temp_C"], l.max_temp_C, within(-40, 250, "degC"));
   if (l.min_udc_V >= l.max_udc_V)
-    p.fail(ptr + "/min_udc_V", num(l.min_udc_V) + " must be below max_udc_V (" + num(l.max_udc_V) + ")");
+    v["min_udc_V"].fail(num(l.min_udc_V) + " must be below max_udc_V (" + num(l.max_udc_V) + ")");
 }
 
-void parse_configurations(Parser& p, const json& v, const std::string& ptr, bool thesis_rules,
-                          std::vector<PlannedConfiguration>& out) {
-  if (!v.is_array()) {
-    p.fail(ptr, "must be a list of {\"estimator\", \"pwm\"}");
-    return;
-  }
-  if (v.empty()) {
-    p.fail(ptr, "must not be empty");
-    return;
-  }
+void parse_configurations(const JsonNode& v, bool thesis_rules, std::vector<PlannedConfiguration>& out) {
+  JsonReader& r = v.reader();
+  const auto items = v.list("must be a list of {\"estimator\", \"pwm\"}", true);
+  if (!items) return;
   std::vector<PlannedConfiguration> list;
   bool ok = true;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const std::string cp = ptr + "/" + std::to_string(i);
-    if (!p.object(v[i], cp)) {
+  for (const JsonNode& c : *items) {
+    if (!c.object()) {
       ok = false;
       continue;
     }
-    const json& c = v[i];
-    const std::size_t before = p.errors.size();
-    p.reject_unknown(c, cp, {"estimator", "pwm", "min_speed_rpm", "max_speed_rpm", "gate_average_s"});
+    const std::size_t before = r.count();
+    c.reject_unknown({"estimator", "pwm", "min_speed_rpm", "max_speed_rpm", "gate_average_s"});
     PlannedConfiguration pc;
-    const auto est = p.string(c, cp, "estimator");
-    const auto pwm = p.string(c, cp, "pwm");
-    if (!c.contains("estimator")) p.fail(cp + "/estimator", "required field is missing");
-    if (!c.contains("pwm")) p.fail(cp + "/pwm", "required field is missing");
-    if (est) {
-      if (auto e = drivers::parse_estimator(*est)) pc.configuration.estimator = *e;
-      else p.fail(cp + "/estimator", "unknown estimator " + in_quotes(*est) + " (expected " + estimator_list() + ")");
-    }
-    if (pwm) {
-      if (auto w = drivers::parse_pwm(*pwm)) pc.configuration.pwm = *w;
-      else p.fail(cp + "/pwm", "unknown PWM scheme " + in_quotes(*pwm) + " (expected " + pwm_list() + ")");
-    }
+    const auto est = c["estimator"].required().choice<drivers::Estimator>(drivers::kEstimatorNames, "estimator");
+    const auto pwm = c["pwm"].required().choice<drivers::Pwm>(drivers::kPwmNames, "PWM scheme");
+    if (est) pc.configuration.estimator = *est;
+    if (pwm) pc.configuration.pwm = *pwm;
     if (thesis_rules) pc = with_thesis_defaults(pc.configuration);
-    p.set(c, cp, "min_speed_rpm", pc.min_speed_rpm, non_negative());
-    if (const auto it = c.find("max_speed_rpm"); it != c.end() && !it->is_null()) {
-      if (auto x = p.number_value(*it, cp + "/max_speed_rpm", positive())) pc.max_speed_rpm = *x;
-    }
-    if (const auto it = c.find("gate_average_s"); it != c.end()) {
-      if (it->is_null()) pc.gate_average_s.reset();
-      else if (auto x = p.number_value(*it, cp + "/gate_average_s", non_negative())) pc.gate_average_s = *x;
-    }
+    set(c["min_speed_rpm"], pc.min_speed_rpm, non_negative());
+    set_or_clear(c["max_speed_rpm"], pc.max_speed_rpm, positive());
+    set_or_clear(c["gate_average_s"], pc.gate_average_s, non_negative());
     if (pc.max_speed_rpm && *pc.max_speed_rpm < pc.min_speed_rpm)
-      p.fail(cp + "/max_speed_rpm", "must be >= min_speed_rpm (" + num(pc.min_speed_rpm) + ")");
-    if (p.errors.size() != before) {
+      c["max_speed_rpm"].fail("must be >= min_speed_rpm (" + num(pc.min_speed_rpm) + ")");
+    if (r.count() != before) {
       ok = false;
       continue;
     }
     for (std::size_t j = 0; j < list.size(); ++j) {
       if (list[j].configuration == pc.configuration) {
-        p.fail(cp, "duplicate of " + ptr + "/" + std::to_string(j) + " (" + label(pc.configuration) + ")");
+        c.fail("duplicate of " + v.pointer() + "/" + std::to_string(j) + " (" + label(pc.configuration) + ")");
         ok = false;
       }
     }
@@ -343,40 +225,32 @@ void parse_configurations(Parser& p, const json& v, const std::string& ptr, bool
   if (ok) out = std::move(list);
 }
 
-void parse_operating_points(Parser& p, const json& v, const std::string& ptr, const SweepLimits& lim,
-                            std::vector<OperatingPoint>& out) {
-  if (!v.is_array()) {
-    p.fail(ptr, "must be a list of {\"speed_rpm\", \"load_Nm\"}");
-    return;
-  }
-  if (v.empty()) {
-    p.fail(ptr, "must not be empty");
-    return;
-  }
+void parse_operating_points(const JsonNode& v, const SweepLimits& lim, std::vector<OperatingPoint>& out) {
+  JsonReader& r = v.reader();
+  const auto items = v.list("must be a list of {\"speed_rpm\", \"load_Nm\"}", true);
+  if (!items) return;
   std::vector<OperatingPoint> list;
   bool ok = true;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const std::string op = ptr + "/" + std::to_string(i);
-    if (!p.object(v[i], op)) {
+  for (const JsonNode& o : *items) {
+    if (!o.object()) {
       ok = false;
       continue;
     }
-    const json& o = v[i];
-    const std::size_t before = p.errors.size();
-    p.reject_unknown(o, op, {"speed_rpm", "load_Nm", "label"});
-    for (const char* key : {"speed_rpm", "load_Nm"})
-      if (!o.contains(key)) p.fail(op + "/" + key, "required field is missing");
+    const std::size_t before = r.count();
+    o.reject_unknown({"speed_rpm", "load_Nm", "label"});
+    o["speed_rpm"].required();
+    o["load_Nm"].required();
     OperatingPoint pt;
-    p.set(o, op, "speed_rpm", pt.speed_rpm, positive_at_most(lim.max_speed_rpm, "/limits/max_speed_rpm"));
-    p.set(o, op, "load_Nm", pt.load_Nm, non_negative_at_most(lim.max_load_Nm, "/limits/max_load_Nm"));
-    if (auto s = p.string(o, op, "label")) pt.label = *s;
-    if (p.errors.size() != before) {
+    set(o["speed_rpm"], pt.speed_rpm, positive_at_most(lim.max_speed_rpm, "/limits/max_speed_rpm"));
+    set(o["load_Nm"], pt.load_Nm, non_negative_at_most(lim.max_load_Nm, "/limits/max_load_Nm"));
+    if (auto s = o["label"].text()) pt.label = *s;
+    if (r.count() != before) {
       ok = false;
       continue;
     }
     for (std::size_t j = 0; j < list.size(); ++j) {
       if (list[j].speed_rpm == pt.speed_rpm && list[j].load_Nm == pt.load_Nm) {
-        p.fail(op, "duplicate of " + ptr + "/" + std::to_string(j));
+        o.fail("duplicate of " + v.pointer() + "/" + std::to_string(j));
         ok = false;
       }
     }
@@ -385,74 +259,63 @@ void parse_operating_points(Parser& p, const json& v, const std::string& ptr, co
   if (ok) out = std::move(list);
 }
 
-void parse_dimensions(Parser& p, const json& doc, SweepPlan& plan, bool has_preset) {
-  const auto it = doc.find("dimensions");
+void parse_dimensions(const JsonNode& d, SweepPlan& plan, bool has_preset) {
   const bool grid = plan.mode == SweepMode::grid;
   if (plan.mode == SweepMode::adaptive) plan.angles_deg.clear();
-  if (it == doc.end()) {
-    if (!has_preset) p.fail("/dimensions", "required field is missing (or name a preset)");
+  if (!d.present()) {
+    if (!has_preset) d.fail("required field is missing (or name a preset)");
     return;
   }
-  const std::string ptr = "/dimensions";
-  if (!p.object(*it, ptr)) return;
-  const json& d = *it;
-  p.reject_unknown(d, ptr, {"speed_rpm", "load_Nm", "angle_deg", "operating_points", "configurations"});
+  if (!d.object()) return;
+  d.reject_unknown({"speed_rpm", "load_Nm", "angle_deg", "operating_points", "configurations"});
   const auto& lim = plan.limits;
 
-  const bool has_speed = d.contains("speed_rpm"), has_load = d.contains("load_Nm");
-  const bool has_points = d.contains("operating_points");
-  if (has_points) {
+  const bool has_speed = d.has("speed_rpm"), has_load = d.has("load_Nm");
+  if (d.has("operating_points")) {
     if (has_speed || has_load) {
-      p.fail(ptr + "/operating_points", "cannot be combined with speed_rpm and load_Nm (it replaces both)");
+      d["operating_points"].fail("cannot be combined with speed_rpm and load_Nm (it replaces both)");
     } else {
       plan.speeds_rpm.clear();
       plan.loads_Nm.clear();
-      parse_operating_points(p, d["operating_points"], ptr + "/operating_points", lim, plan.operating_points);
+      parse_operating_points(d["operating_points"], lim, plan.operating_points);
     }
   } else if ((has_speed || has_load) && !plan.operating_points.empty()) {
-    p.fail(ptr + (has_speed ? "/speed_rpm" : "/load_Nm"),
-           "the preset " + in_quotes(plan.preset) + " gives operating points; override them with " + ptr +
-               "/operating_points");
+    d[has_speed ? "speed_rpm" : "load_Nm"].fail("the preset " + in_quotes(plan.preset) +
+                                                " gives operating points; override them with " + d.pointer() +
+                                                "/operating_points");
   } else {
     if (has_speed) {
-      if (auto v = p.dimension(d["speed_rpm"], ptr + "/speed_rpm",
-                               positive_at_most(lim.max_speed_rpm, "/limits/max_speed_rpm")))
+      if (auto v = dimension(d["speed_rpm"], positive_at_most(lim.max_speed_rpm, "/limits/max_speed_rpm")))
         plan.speeds_rpm = *v;
     }
     if (has_load) {
-      if (auto v = p.dimension(d["load_Nm"], ptr + "/load_Nm",
-                               non_negative_at_most(lim.max_load_Nm, "/limits/max_load_Nm")))
+      if (auto v = dimension(d["load_Nm"], non_negative_at_most(lim.max_load_Nm, "/limits/max_load_Nm")))
         plan.loads_Nm = *v;
     }
   }
-  if (d.contains("angle_deg")) {
+  if (d.has("angle_deg")) {
     if (grid) {
-      if (auto v = p.dimension(d["angle_deg"], ptr + "/angle_deg", angle_check())) plan.angles_deg = *v;
+      if (auto v = dimension(d["angle_deg"], angle_check())) plan.angles_deg = *v;
     } else {
-      p.fail(ptr + "/angle_deg", "not used in adaptive mode: the search picks the angles within /adaptive/bracket_deg");
+      d["angle_deg"].fail("not used in adaptive mode: the search picks the angles within /adaptive/bracket_deg");
     }
   }
-  if (d.contains("configurations"))
-    parse_configurations(p, d["configurations"], ptr + "/configurations", plan.preset == kThesisGridPreset,
-                         plan.configurations);
+  if (d.has("configurations"))
+    parse_configurations(d["configurations"], plan.preset == kThesisGridPreset, plan.configurations);
 }
 
-void parse_adaptive(Parser& p, const json& doc, AngleSearchOptions& a) {
-  const auto it = doc.find("adaptive");
-  if (it == doc.end()) return;
-  const std::string ptr = "/adaptive";
-  if (!p.object(*it, ptr)) return;
-  const json& v = *it;
-  p.reject_unknown(v, ptr, {"bracket_deg", "tolerance_deg", "max_evaluations", "stencil_deg", "resolution_deg"});
-  if (const auto b = v.find("bracket_deg"); b != v.end()) {
-    if (!b->is_array() || b->size() != 2) {
-      p.fail(ptr + "/bracket_deg", "must be [from, to]");
+void parse_adaptive(const JsonNode& v, AngleSearchOptions& a) {
+  if (!v.object()) return;
+  v.reject_unknown({"bracket_deg", "tolerance_deg", "max_evaluations", "stencil_deg", "resolution_deg"});
+  if (const JsonNode b = v["bracket_deg"]; b.present()) {
+    if (!b.json().is_array() || b.json().size() != 2) {
+      b.fail("must be [from, to]");
     } else {
-      const auto from = p.number_value((*b)[0], ptr + "/bracket_deg/0", angle_check());
-      const auto to = p.number_value((*b)[1], ptr + "/bracket_deg/1", angle_check());
+      const auto from = b.at(0).number(angle_check());
+      const auto to = b.at(1).number(angle_check());
       if (from && to) {
         if (*from >= *to) {
-          p.fail(ptr + "/bracket_deg/1", "must be above the bracket's start (" + num(*from) + ")");
+          b.at(1).fail("must be above the bracket's start (" + num(*from) + ")");
         } else {
           a.from_deg = *from;
           a.to_deg = *to;
@@ -460,74 +323,52 @@ void parse_adaptive(Parser& p, const json& doc, AngleSearchOptions& a) {
       }
     }
   }
-  p.set(v, ptr, "tolerance_deg", a.tolerance_deg, [](double x) {
-    return x > 0 && x <= 10 ? std::string() : "must be within (0, 10] deg";
-  });
-  p.set(v, ptr, "stencil_deg", a.stencil_deg, [](double x) {
-    return x > 0 && x <= 45 ? std::string() : "must be within (0, 45] deg";
-  });
-  p.set(v, ptr, "resolution_deg", a.resolution_deg, [](double x) {
-    return x > 0 && x <= 1 ? std::string() : "must be within (0, 1] deg";
-  });
-  if (const auto m = v.find("max_evaluations"); m != v.end()) {
-    // Golden section needs two points and a parabola three.
-    if (!m->is_number_integer() || m->get<std::int64_t>() < 3 || m->get<std::int64_t>() > 100)
-      p.fail(ptr + "/max_evaluations", "must be an integer in 3..100");
-    else
-      a.max_evaluations = static_cast<std::size_t>(m->get<std::int64_t>());
-  }
+  set(v["tolerance_deg"], a.tolerance_deg, above_at_most(0, 10, "deg"));
+  set(v["stencil_deg"], a.stencil_deg, above_at_most(0, 45, "deg"));
+  set(v["resolution_deg"], a.resolution_deg, above_at_most(0, 1, "deg"));
+  // Golden section needs two points and a parabola three.
+  if (auto m = v["max_evaluations"].integer(3, 100)) a.max_evaluations = static_cast<std::size_t>(*m);
 }
 
-void parse_gate(Parser& p, const json& doc, GateOptions& g) {
-  const auto it = doc.find("gate");
-  if (it == doc.end()) return;
-  const std::string ptr = "/gate";
-  if (!p.object(*it, ptr)) return;
-  const json& v = *it;
-  p.reject_unknown(v, ptr, {"span_s", "speed_band_rpm", "im_band_rel", "im_band_min_A", "power_band_rel",
-                            "power_band_min_W", "average_s", "min_settle_s", "timeout_s"});
+void parse_gate(const JsonNode& v, GateOptions& g) {
+  if (!v.object()) return;
+  v.reject_unknown({"span_s", "speed_band_rpm", "im_band_rel", "im_band_min_A", "power_band_rel", "power_band_min_W",
+                    "average_s", "min_settle_s", "timeout_s"});
   // The band floors must be > 0: a zero band is never met by a measured signal.
-  p.set(v, ptr, "span_s", g.bands.span_s, positive());
-  p.set(v, ptr, "speed_band_rpm", g.bands.speed_band_rpm, positive());
-  p.set(v, ptr, "im_band_rel", g.bands.im_band_rel, non_negative());
-  p.set(v, ptr, "im_band_min_A", g.bands.im_band_min_A, positive());
-  p.set(v, ptr, "power_band_rel", g.bands.power_band_rel, non_negative());
-  p.set(v, ptr, "power_band_min_W", g.bands.power_band_min_W, positive());
-  p.set(v, ptr, "average_s", g.bands.average_s, non_negative());
-  p.set(v, ptr, "min_settle_s", g.min_settle_s, non_negative());
-  p.set(v, ptr, "timeout_s", g.timeout_s, positive());
+  set(v["span_s"], g.bands.span_s, positive());
+  set(v["speed_band_rpm"], g.bands.speed_band_rpm, positive());
+  set(v["im_band_rel"], g.bands.im_band_rel, non_negative());
+  set(v["im_band_min_A"], g.bands.im_band_min_A, positive());
+  set(v["power_band_rel"], g.bands.power_band_rel, non_negative());
+  set(v["power_band_min_W"], g.bands.power_band_min_W, positive());
+  set(v["average_s"], g.bands.average_s, non_negative());
+  set(v["min_settle_s"], g.min_settle_s, non_negative());
+  set(v["timeout_s"], g.timeout_s, positive());
   if (g.timeout_s <= g.min_settle_s)
-    p.fail(ptr + "/timeout_s", num(g.timeout_s) + " must exceed min_settle_s (" + num(g.min_settle_s) + ")");
+    v["timeout_s"].fail(num(g.timeout_s) + " must exceed min_settle_s (" + num(g.min_settle_s) + ")");
 }
 
-void parse_thermal(Parser& p, const json& doc, ThermalOptions& t, const SweepLimits& lim) {
-  const std::string ptr = "/thermal";
-  const auto it = doc.find("thermal");
-  if (it != doc.end()) {
-    if (!p.object(*it, ptr)) return;
-    const json& v = *it;
-    p.reject_unknown(v, ptr, {"enabled", "target_C", "band_C", "warmup_load_Nm", "warmup_speed_rpm", "timeout_s"});
-    p.set_bool(v, ptr, "enabled", t.enabled);
-    p.set(v, ptr, "target_C", t.target_C, within(0, 200, "degC"));
-    p.set(v, ptr, "band_C", t.band_C, positive());
-    p.set(v, ptr, "warmup_load_Nm", t.warmup_load_Nm, non_negative());
-    if (const auto w = v.find("warmup_speed_rpm"); w != v.end()) {
-      if (w->is_null()) t.warmup_speed_rpm.reset();
-      else if (auto x = p.number_value(*w, ptr + "/warmup_speed_rpm", positive())) t.warmup_speed_rpm = *x;
-    }
-    p.set(v, ptr, "timeout_s", t.timeout_s, positive());
+void parse_thermal(const JsonNode& v, ThermalOptions& t, const SweepLimits& lim) {
+  if (v.present()) {
+    if (!v.object()) return;
+    v.reject_unknown({"enabled", "target_C", "band_C", "warmup_load_Nm", "warmup_speed_rpm", "timeout_s"});
+    if (auto e = v["enabled"].boolean()) t.enabled = *e;
+    set(v["target_C"], t.target_C, within(0, 200, "degC"));
+    set(v["band_C"], t.band_C, positive());
+    set(v["warmup_load_Nm"], t.warmup_load_Nm, non_negative());
+    set_or_clear(v["warmup_speed_rpm"], t.warmup_speed_rpm, positive());
+    set(v["timeout_s"], t.timeout_s, positive());
   }
   // Checked against the limits also when the values are defaults, so lowering a limit cannot
   // leave a default beyond it.
   if (t.target_C + t.band_C >= lim.max_temp_C)
-    p.fail(ptr + "/target_C", "target_C + band_C (" + num(t.target_C + t.band_C) +
-                                  ") must stay below /limits/max_temp_C (" + num(lim.max_temp_C) + ")");
+    v["target_C"].fail("target_C + band_C (" + num(t.target_C + t.band_C) + ") must stay below /limits/max_temp_C (" +
+                       num(lim.max_temp_C) + ")");
   if (t.warmup_load_Nm > lim.max_load_Nm)
-    p.fail(ptr + "/warmup_load_Nm", num(t.warmup_load_Nm) + " exceeds /limits/max_load_Nm (" +
-                                        num(lim.max_load_Nm) + ")");
+    v["warmup_load_Nm"].fail(num(t.warmup_load_Nm) + " exceeds /limits/max_load_Nm (" + num(lim.max_load_Nm) + ")");
   if (t.warmup_speed_rpm && *t.warmup_speed_rpm > lim.max_speed_rpm)
-    p.fail(ptr + "/warmup_speed_rpm", num(*t.warmup_speed_rpm) + " exceeds /limits/max_speed_rpm (" +
-                                          num(lim.max_speed_rpm) + ")");
+    v["warmup_speed_rpm"].fail(num(*t.warmup_speed_rpm) + " exceeds /limits/max_speed_rpm (" +
+                               num(lim.max_speed_rpm) + ")");
 }
 
 bool speed_allowed(const PlannedConfiguration& c, double speed_rpm) {
@@ -536,7 +377,7 @@ bool speed_allowed(const PlannedConfiguration& c, double speed_rpm) {
 
 // A configuration whose speed range misses every speed of the plan would silently measure
 // nothing; so would an empty plan.
-void check_coverage(Parser& p, const json& doc, const SweepPlan& plan) {
+void check_coverage(JsonReader& p, const json& doc, const SweepPlan& plan) {
   // Values from the document were checked against the limits as they were read; a preset's
   // values are checked here, and reported at /preset.
   const json* dims = doc.contains("dimensions") && doc["dimensions"].is_object() ? &doc["dimensions"] : nullptr;
@@ -606,36 +447,28 @@ void check_coverage(Parser& p, const json& doc, const SweepPlan& plan) {
 
 }  // namespace
 
-std::string to_string(const SweepPlanError& e) {
-  return (e.json_pointer.empty() ? std::string("(document)") : e.json_pointer) + ": " + e.reason;
-}
-
 SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
-  Parser p;
+  JsonReader r;
+  const JsonNode root = drivers::read_root(doc, r);
   SweepPlanParseResult result;
-  if (!doc.is_object()) {
-    result.errors.push_back({"", "must be a JSON object"});
+  if (!root.object()) {
+    result.errors = std::move(r.errors);
     return result;
   }
-  p.reject_unknown(doc, "",
-                   {"name", "preset", "dimensions", "order", "mode", "adaptive", "gate", "window_s", "thermal",
-                    "limits", "notes"});
+  root.reject_unknown({"name", "preset", "dimensions", "order", "mode", "adaptive", "gate", "window_s", "thermal",
+                       "limits", "notes"});
 
-  const bool has_preset = doc.contains("preset");
-  SweepPlan plan = has_preset ? preset_plan(p, doc["preset"]) : SweepPlan{};
+  const bool has_preset = root.has("preset");
+  SweepPlan plan = has_preset ? preset_plan(root["preset"]) : SweepPlan{};
 
-  parse_limits(p, doc, plan.limits);
+  parse_limits(root["limits"], plan.limits);
 
-  if (auto s = p.string(doc, "", "name")) plan.name = *s;
+  if (auto s = root["name"].text()) plan.name = *s;
   if (plan.name.empty()) plan.name = plan.preset.empty() ? "sweep" : plan.preset;
 
-  if (auto s = p.string(doc, "", "mode")) {
-    if (*s == "grid") plan.mode = SweepMode::grid;
-    else if (*s == "adaptive") plan.mode = SweepMode::adaptive;
-    else p.fail("/mode", "unknown mode " + in_quotes(*s) + " (expected grid, adaptive)");
-  }
+  if (auto m = root["mode"].choice<SweepMode>(kSweepModeNames, "mode")) plan.mode = *m;
 
-  if (auto s = p.string(doc, "", "order")) {
+  if (auto s = root["order"].text()) {
     std::array<SweepDimension, 4> order{};
     std::size_t n = 0;
     bool ok = true;
@@ -652,50 +485,39 @@ SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
       order[n++] = *d;
     }
     if (!ok || n != 4) {
-      p.fail("/order", in_quotes(*s) + " must name speed, load, config and angle once each, outermost first, "
-                                    "joined by '-' (e.g. speed-load-config-angle)");
+      root["order"].fail(in_quotes(*s) + " must name speed, load, config and angle once each, outermost first, "
+                                         "joined by '-' (e.g. speed-load-config-angle)");
     } else {
       plan.order = order;
     }
   }
   if (plan.mode == SweepMode::adaptive && plan.order[3] != SweepDimension::angle)
-    p.fail(doc.contains("order") ? "/order" : "/mode",
-           "adaptive mode searches the angle innermost: the order must end with 'angle'");
+    root[root.has("order") ? "order" : "mode"].fail(
+        "adaptive mode searches the angle innermost: the order must end with 'angle'");
 
-  parse_dimensions(p, doc, plan, has_preset);
-  parse_adaptive(p, doc, plan.adaptive);
-  parse_gate(p, doc, plan.gate);
-  if (doc.contains("window_s")) {
-    p.set(doc, "", "window_s", plan.window_s, [](double x) {
-      return x > 0 && x <= 3600 ? std::string() : "must be within (0, 3600] s";
-    });
-  }
-  parse_thermal(p, doc, plan.thermal, plan.limits);
-
-  if (const auto it = doc.find("notes"); it != doc.end()) {
-    bool ok = it->is_array();
-    if (ok)
-      for (const auto& n : *it) ok = ok && n.is_string();
-    if (!ok) p.fail("/notes", "must be a list of strings");
-    else plan.notes = it->get<std::vector<std::string>>();
-  }
+  parse_dimensions(root["dimensions"], plan, has_preset);
+  parse_adaptive(root["adaptive"], plan.adaptive);
+  parse_gate(root["gate"], plan.gate);
+  set(root["window_s"], plan.window_s, above_at_most(0, 3600, "s"));
+  parse_thermal(root["thermal"], plan.thermal, plan.limits);
+  if (auto notes = root["notes"].texts()) plan.notes = *notes;
 
   // Required dimensions that neither the document nor a preset supplied.
-  if (doc.contains("dimensions") && doc["dimensions"].is_object()) {
-    if (plan.operating_points.empty() && !doc["dimensions"].contains("operating_points")) {
-      if (plan.speeds_rpm.empty() && !doc["dimensions"].contains("speed_rpm"))
-        p.fail("/dimensions/speed_rpm", "required field is missing (or give operating_points, or a preset)");
-      if (plan.loads_Nm.empty() && !doc["dimensions"].contains("load_Nm"))
-        p.fail("/dimensions/load_Nm", "required field is missing (or give operating_points, or a preset)");
+  if (const JsonNode d = root["dimensions"]; d.present() && d.json().is_object()) {
+    if (plan.operating_points.empty() && !d.has("operating_points")) {
+      if (plan.speeds_rpm.empty() && !d.has("speed_rpm"))
+        d["speed_rpm"].fail("required field is missing (or give operating_points, or a preset)");
+      if (plan.loads_Nm.empty() && !d.has("load_Nm"))
+        d["load_Nm"].fail("required field is missing (or give operating_points, or a preset)");
     }
-    if (plan.mode == SweepMode::grid && plan.angles_deg.empty() && !doc["dimensions"].contains("angle_deg"))
-      p.fail("/dimensions/angle_deg", "required field in grid mode is missing");
+    if (plan.mode == SweepMode::grid && plan.angles_deg.empty() && !d.has("angle_deg"))
+      d["angle_deg"].fail("required field in grid mode is missing");
   }
   if (plan.configurations.empty()) plan.configurations = {PlannedConfiguration{}};
 
-  if (p.errors.empty()) check_coverage(p, doc, plan);
-  if (p.errors.empty()) result.plan = std::move(plan);
-  result.errors = std::move(p.errors);
+  if (r.ok()) check_coverage(r, doc, plan);
+  if (r.ok()) result.plan = std::move(plan);
+  result.errors = std::move(r.errors);
   return result;
 }
 

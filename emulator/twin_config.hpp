@@ -3,9 +3,21 @@
 // [assumed] in the parameter table (twin_config_schema.cpp), which also validates and documents.
 #pragma once
 
+#include <array>
 #include <string>
+#include <string_view>
+
+#include "drivers/modes.hpp"
 
 namespace synbench::emulator {
+
+// The config's choices, each with its names by value (the config file's spelling).
+enum class LowSpeedSource { hfi, encoder };  // what EEMF hands over to below its minimum speed
+inline constexpr std::array<std::string_view, 2> kLowSpeedSourceNames{"hfi", "encoder"};
+enum class LutRotationSpeed { observer, active_flux };  // the rotor speed EEMF-LUT rotates its map with
+inline constexpr std::array<std::string_view, 2> kLutRotationSpeedNames{"observer", "active-flux"};
+enum class EemfErrorSignal { direction, vector };  // the EEMF angle error: direction alone, or the whole vector
+inline constexpr std::array<std::string_view, 2> kEemfErrorSignalNames{"direction", "vector"};
 
 // Saturated flux linkage of one axis (thesis 1.22, Table 1.2).
 struct FluxAxisParams {
@@ -119,7 +131,7 @@ struct FirmwareParams {
   double overvoltage_trip_V = 450.0;
   double undervoltage_trip_V = 300.0;
   double overtemp_trip_C = 120.0;
-  std::string pwm = "capwm";
+  drivers::Pwm pwm = drivers::Pwm::capwm;
 };
 
 // Sensorless estimators (physics.md 8). The EKFs keep the thesis tuning of their own params.
@@ -139,7 +151,7 @@ struct EemfConfig {
   double speed_filter_s = 0.002;   // low-pass on the speed the observer reports
   double min_speed_rpm = 500.0;
   double handover_hysteresis_rpm = 25.0;
-  std::string low_speed_source = "encoder";
+  LowSpeedSource low_speed_source = LowSpeedSource::encoder;
   double lut_ld_scale = 1.0;
   double lut_lq_scale = 1.0;
   double rls_forgetting = 0.99;
@@ -148,10 +160,10 @@ struct EemfConfig {
   double rls_estimate_filter_s = 0.2;  // low-pass on the estimates reported
   double rls_model_filter_s = 2.0;     // low-pass on the estimates the observer uses
   double rls_warmup_s = 0.3;           // identification time before the observer uses it
-  std::string lut_rotation_speed = "observer";  // the thesis; or "active-flux" [ours]
+  LutRotationSpeed lut_rotation_speed = LutRotationSpeed::observer;  // the thesis; or active-flux [ours]
   // EEMF-LUT and EEMF-RLS: the angle error from the EEMF's "direction" (the thesis) or its whole
   // "vector" against the model's magnitude [ours]; EEMF-CONST always the direction.
-  std::string error_signal = "vector";
+  EemfErrorSignal error_signal = EemfErrorSignal::vector;
   double rls_emf_scale_filter_s = 0.2;  // EEMF-RLS: the predicted magnitude scaled to the measured
   bool rls_flux_offset = true;  // EEMF-RLS: static flux from the identified flux offsets [ours]
   double flux_blend_rad_s = 5.0;

@@ -19,24 +19,25 @@ struct RowBuilder {
   std::vector<ParamRow>& rows;
   // Positive quantity from the thesis.
   void pos(std::string key, double* f, std::string source, std::string doc, bool assumed = false) {
-    rows.push_back({std::move(key), f, 0, kInf, true, {}, assumed, std::move(source), std::move(doc)});
+    rows.push_back({std::move(key), f, 0, kInf, true, assumed, std::move(source), std::move(doc)});
   }
   void num(std::string key, double* f, double lo, double hi, std::string source, std::string doc,
            bool assumed = false) {
-    rows.push_back({std::move(key), f, lo, hi, false, {}, assumed, std::move(source), std::move(doc)});
+    rows.push_back({std::move(key), f, lo, hi, false, assumed, std::move(source), std::move(doc)});
   }
   void integer(std::string key, int* f, int lo, int hi, std::string source, std::string doc,
                bool assumed = false) {
-    rows.push_back({std::move(key), f, double(lo), double(hi), false, {}, assumed, std::move(source),
+    rows.push_back({std::move(key), f, double(lo), double(hi), false, assumed, std::move(source),
                     std::move(doc)});
   }
   void flag(std::string key, bool* f, std::string source, std::string doc, bool assumed = false) {
-    rows.push_back({std::move(key), f, 0, 0, false, {}, assumed, std::move(source), std::move(doc)});
+    rows.push_back({std::move(key), f, 0, 0, false, assumed, std::move(source), std::move(doc)});
   }
-  void choice(std::string key, std::string* f, std::vector<std::string> choices, std::string source,
+  template <typename E, std::size_t N>
+  void choice(std::string key, E* f, const std::array<std::string_view, N>& names, std::string source,
               std::string doc, bool assumed = false) {
-    rows.push_back({std::move(key), f, 0, 0, false, std::move(choices), assumed, std::move(source),
-                    std::move(doc)});
+    ChoiceField c{names, [f] { return static_cast<std::size_t>(*f); }, [f](std::size_t i) { *f = static_cast<E>(i); }};
+    rows.push_back({std::move(key), std::move(c), 0, 0, false, assumed, std::move(source), std::move(doc)});
   }
 };
 
@@ -53,9 +54,8 @@ void flux_rows(RowBuilder& b, const std::string& axis, FluxAxisParams& p) {
 
 }  // namespace
 
-ConfigError::ConfigError(std::string key, std::string reason)
-    : std::runtime_error("config key '" + key + "': " + reason), key_(std::move(key)),
-      reason_(std::move(reason)) {}
+ConfigError::ConfigError(drivers::JsonError error)
+    : std::runtime_error(error.pointer.empty() ? error.reason : drivers::to_string(error)), error_(std::move(error)) {}
 
 std::vector<ParamRow> param_table(TwinConfig& c) {
   std::vector<ParamRow> rows;
@@ -161,7 +161,7 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("firmware.overvoltage_trip_V", &f.overvoltage_trip_V, "Sec. 6.1", "over-voltage trip (capacitor limit)");
   b.pos("firmware.undervoltage_trip_V", &f.undervoltage_trip_V, "assumed", "under-voltage trip", A);
   b.pos("firmware.overtemp_trip_C", &f.overtemp_trip_C, "assumed", "winding over-temperature trip", A);
-  b.choice("firmware.pwm", &f.pwm, {"capwm", "aspwm"}, "Sec. 5.2", "switching scheme at start");
+  b.choice("firmware.pwm", &f.pwm, drivers::kPwmNames, "Sec. 5.2", "switching scheme at start");
 
   auto& h = c.estimators.hfi;
   b.pos("estimators.hfi.voltage_V", &h.voltage_V, "Sec. 6.2.2", "HFI carrier amplitude on the estimated d axis");
@@ -182,13 +182,13 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.num("estimators.eemf.min_speed_rpm", &e.min_speed_rpm, 0, 10000, "Sec. 6.3.2", "below it EEMF hands over to the low-speed source");
   b.num("estimators.eemf.handover_hysteresis_rpm", &e.handover_hysteresis_rpm, 0, 1000, "assumed",
         "hysteresis around the minimum speed", A);
-  b.choice("estimators.eemf.low_speed_source", &e.low_speed_source, {"hfi", "encoder"}, "Sec. 6.3.2",
+  b.choice("estimators.eemf.low_speed_source", &e.low_speed_source, kLowSpeedSourceNames, "Sec. 6.3.2",
            "position source below the minimum speed");
   b.pos("estimators.eemf.lut_ld_scale", &e.lut_ld_scale, "Sec. 4 (4.1)", "EEMF-LUT table deformation kd (1 = exact tables)");
   b.pos("estimators.eemf.lut_lq_scale", &e.lut_lq_scale, "Sec. 4 (4.2)", "EEMF-LUT table deformation kq (1 = exact tables)");
-  b.choice("estimators.eemf.lut_rotation_speed", &e.lut_rotation_speed, {"observer", "active-flux"}, "Sec. 6.2.3",
+  b.choice("estimators.eemf.lut_rotation_speed", &e.lut_rotation_speed, kLutRotationSpeedNames, "Sec. 6.2.3",
            "EEMF-LUT: rotor speed in the w Lq terms and the derivative's frame, the tracking observer's (the thesis; EEMF-CONST and EEMF-RLS always) or the active flux's (ours, docs/estimators.md)");
-  b.choice("estimators.eemf.error_signal", &e.error_signal, {"direction", "vector"}, "Sec. 6.2.3",
+  b.choice("estimators.eemf.error_signal", &e.error_signal, kEemfErrorSignalNames, "Sec. 6.2.3",
            "EEMF-LUT and EEMF-RLS: the angle error from the EEMF's direction only (the thesis) or from its whole vector, the magnitude against the model's prediction as well (ours, docs/estimators.md; EEMF-CONST always the direction)");
   b.num("estimators.eemf.rls_emf_scale_filter_s", &e.rls_emf_scale_filter_s, 0, 100, "assumed",
         "EEMF-RLS with the vector error: time constant over which the predicted EEMF magnitude is scaled to the measured one (the identified inductances miss the saturated d axis' flux offset; 0: not scaled)", A);
@@ -212,7 +212,7 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.num("estimators.ekf.rs_speed_threshold_rpm", &c.estimators.ekf.rs_speed_threshold_rpm, 0, 10000, "assumed",
         "EKF-RS holds Rs (no process noise) below this speed (Fig. 5.21)", A);
 
-  rows.push_back({"sim.seed", &c.sim.seed_int, 0, 2147483647.0, false, {}, false, "-", "noise generator seed"});
+  rows.push_back({"sim.seed", &c.sim.seed_int, 0, 2147483647.0, false, false, "-", "noise generator seed"});
   return rows;
 }
 
@@ -224,79 +224,93 @@ std::string describe_range(const ParamRow& r) {
   return s.str();
 }
 
-void set_row(const ParamRow& r, const synbench::Json& v) {
+// "synrm.flux_d.l0_H" -> "/synrm/flux_d/l0_H" (keys hold neither '~' nor '/').
+std::string pointer_of(std::string key) {
+  for (auto& ch : key)
+    if (ch == '.') ch = '/';
+  return "/" + key;
+}
+
+[[noreturn]] void fail(const std::string& key, std::string reason) {
+  throw ConfigError({pointer_of(key), std::move(reason)});
+}
+
+// The first problem the reader found, thrown: the twin config stops at its first bad key.
+void throw_first(const drivers::JsonReader& r) {
+  if (!r.ok()) throw ConfigError(r.errors.front());
+}
+
+void set_row(const ParamRow& r, const drivers::JsonNode& v) {
   std::visit(
-      [&](auto* f) {
-        using T = std::remove_pointer_t<decltype(f)>;
-        if constexpr (std::is_same_v<T, bool>) {
-          if (!v.is_boolean()) throw ConfigError(r.key, "must be true or false");
-          *f = v.get<bool>();
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          if (!v.is_string()) throw ConfigError(r.key, "must be a string");
-          auto s = v.get<std::string>();
-          bool ok = r.choices.empty();
-          for (const auto& c : r.choices) ok = ok || c == s;
-          if (!ok) {
-            std::string list;
-            for (const auto& c : r.choices) list += (list.empty() ? "" : ", ") + c;
-            throw ConfigError(r.key, "'" + s + "' is not one of: " + list);
-          }
-          *f = s;
+      [&](auto& f) {
+        using F = std::remove_cvref_t<decltype(f)>;
+        if constexpr (std::is_same_v<F, bool*>) {
+          if (auto b = v.boolean()) *f = *b;
+        } else if constexpr (std::is_same_v<F, ChoiceField>) {
+          const auto dot = r.key.rfind('.');
+          if (auto i = v.choice<std::size_t>(f.names, r.key.substr(dot + 1))) f.set(*i);
+        } else if constexpr (std::is_same_v<F, int*>) {
+          if (auto i = v.integer(static_cast<std::int64_t>(r.min), static_cast<std::int64_t>(r.max)))
+            *f = static_cast<int>(*i);
         } else {
-          if (!v.is_number()) throw ConfigError(r.key, "must be a number");
-          const double x = v.get<double>();
-          if (!std::isfinite(x)) throw ConfigError(r.key, "must be finite");
-          if constexpr (std::is_same_v<T, int>) {
-            if (!v.is_number_integer()) throw ConfigError(r.key, "must be an integer");
-          }
-          const bool low = r.min_exclusive ? x <= r.min : x < r.min;
-          if (low || x > r.max) {
-            std::ostringstream s;
-            s << x << " is outside " << describe_range(r);
-            throw ConfigError(r.key, s.str());
-          }
-          *f = static_cast<T>(x);
+          const auto value = v.number([&](double x) {
+            const bool low = r.min_exclusive ? x <= r.min : x < r.min;
+            return low || x > r.max ? drivers::format_number(x) + " is outside " + describe_range(r) : std::string();
+          });
+          if (value) *f = *value;
         }
       },
       r.field);
+  throw_first(v.reader());
 }
 
-void walk(const synbench::Json& node, const std::string& prefix,
+void walk(const drivers::JsonNode& node, const std::string& prefix,
           const std::map<std::string, const ParamRow*>& rows) {
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    if (!it.key().empty() && it.key()[0] == '_') continue;
-    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+  for (const auto& [name, value] : node.members()) {
+    const std::string key = prefix.empty() ? name : prefix + "." + name;
     if (auto row = rows.find(key); row != rows.end()) {
-      set_row(*row->second, it.value());
-    } else if (it.value().is_object()) {
+      set_row(*row->second, value);
+    } else if (value.json().is_object()) {
       bool section = false;
       for (const auto& [k, r] : rows) section = section || k.rfind(key + ".", 0) == 0;
-      if (!section) throw ConfigError(key, "unknown key");
-      walk(it.value(), key, rows);
+      if (!section) value.fail("unknown field");
+      throw_first(node.reader());
+      walk(value, key, rows);
     } else {
-      throw ConfigError(key, "unknown key");
+      value.fail("unknown field");
+      throw_first(node.reader());
     }
   }
 }
 
 synbench::Json row_value(const ParamRow& r) {
-  return std::visit([](auto* f) { return synbench::Json(*f); }, r.field);
+  return std::visit(
+      [](const auto& f) {
+        if constexpr (std::is_same_v<std::remove_cvref_t<decltype(f)>, ChoiceField>)
+          return synbench::Json(f.names[f.get()]);
+        else
+          return synbench::Json(*f);
+      },
+      r.field);
 }
 
 }  // namespace
 
 void apply_json(TwinConfig& config, const synbench::Json& doc) {
-  if (!doc.is_object()) throw ConfigError("(root)", "must be a JSON object");
+  drivers::JsonReader reader;
+  const drivers::JsonNode root = drivers::read_root(doc, reader);
+  root.object("the document must be a JSON object");
+  throw_first(reader);
   auto table = param_table(config);
   std::map<std::string, const ParamRow*> rows;
   for (const auto& r : table) rows[r.key] = &r;
-  walk(doc, "", rows);
+  walk(root, "", rows);
   validate(config);
 }
 
 TwinConfig load_twin_config_file(const std::string& path) {
   const drivers::JsonParsed read = drivers::read_json_file(path);
-  if (!read.ok()) throw ConfigError("(file)", read.error);
+  if (!read.ok()) throw ConfigError({"", read.error});
   TwinConfig config;
   apply_json(config, read.doc);
   return config;
@@ -304,34 +318,34 @@ TwinConfig load_twin_config_file(const std::string& path) {
 
 void validate(const TwinConfig& c) {
   if (c.dc_bus.brake_off_V >= c.dc_bus.brake_on_V)
-    throw ConfigError("dc_bus.brake_off_V", "must be below dc_bus.brake_on_V");
+    fail("dc_bus.brake_off_V", "must be below dc_bus.brake_on_V");
   if (c.dc_bus.brake_on_V >= c.firmware.overvoltage_trip_V)
-    throw ConfigError("dc_bus.brake_on_V", "must be below firmware.overvoltage_trip_V");
+    fail("dc_bus.brake_on_V", "must be below firmware.overvoltage_trip_V");
   if (c.firmware.undervoltage_trip_V >= c.dc_bus.source_V)
-    throw ConfigError("firmware.undervoltage_trip_V", "must be below dc_bus.source_V");
+    fail("firmware.undervoltage_trip_V", "must be below dc_bus.source_V");
   if (c.firmware.max_speed_rpm >= c.firmware.overspeed_trip_rpm)
-    throw ConfigError("firmware.max_speed_rpm", "must be below firmware.overspeed_trip_rpm");
+    fail("firmware.max_speed_rpm", "must be below firmware.overspeed_trip_rpm");
   if (c.firmware.current_limit_A >= c.firmware.overcurrent_trip_A)
-    throw ConfigError("firmware.current_limit_A", "must be below firmware.overcurrent_trip_A");
+    fail("firmware.current_limit_A", "must be below firmware.overcurrent_trip_A");
   if (c.firmware.overcurrent_trip_A >= c.firmware.adc_range_A)
-    throw ConfigError("firmware.overcurrent_trip_A", "must be below firmware.adc_range_A");
+    fail("firmware.overcurrent_trip_A", "must be below firmware.adc_range_A");
   if (c.firmware.speed_loop_rate_Hz > c.inverter.pwm_frequency_Hz)
-    throw ConfigError("firmware.speed_loop_rate_Hz", "must not exceed inverter.pwm_frequency_Hz");
+    fail("firmware.speed_loop_rate_Hz", "must not exceed inverter.pwm_frequency_Hz");
   const double ratio = c.inverter.pwm_frequency_Hz / c.firmware.speed_loop_rate_Hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9)
-    throw ConfigError("firmware.speed_loop_rate_Hz", "must divide inverter.pwm_frequency_Hz");
+    fail("firmware.speed_loop_rate_Hz", "must divide inverter.pwm_frequency_Hz");
   if (c.estimators.hfi.frequency_Hz * 4 > c.inverter.pwm_frequency_Hz)
-    throw ConfigError("estimators.hfi.frequency_Hz", "must be at most a quarter of the PWM frequency");
+    fail("estimators.hfi.frequency_Hz", "must be at most a quarter of the PWM frequency");
   if (c.estimators.eemf.rls_sample_s < c.step_s())
-    throw ConfigError("estimators.eemf.rls_sample_s", "must be at least one PWM period");
+    fail("estimators.eemf.rls_sample_s", "must be at least one PWM period");
   if (c.firmware.current_bandwidth_Hz * 10 > c.inverter.pwm_frequency_Hz)
-    throw ConfigError("firmware.current_bandwidth_Hz", "must be at most a tenth of the PWM frequency");
+    fail("firmware.current_bandwidth_Hz", "must be at most a tenth of the PWM frequency");
   auto check_axis = [](const FluxAxisParams& p, const std::string& axis) {
     // The two branches must cross (the switch point is their upper crossing).
     const double a = p.l0_H - p.l1_H;
-    if (a <= 0) throw ConfigError("synrm.flux_" + axis + ".l1_H", "must be below l0_H");
+    if (a <= 0) fail("synrm.flux_" + axis + ".l1_H", "must be below l0_H");
     if (p.psi0_Wb * p.psi0_Wb + 4 * a * p.beta_WbA < 0)
-      throw ConfigError("synrm.flux_" + axis + ".beta_WbA", "the saturated branch never meets the linear one");
+      fail("synrm.flux_" + axis + ".beta_WbA", "the saturated branch never meets the linear one");
   };
   check_axis(c.synrm.flux_d, "d");
   check_axis(c.synrm.flux_q, "q");
@@ -364,8 +378,8 @@ std::string markdown_reference(const TwinConfig& config) {
     std::string valid;
     if (std::holds_alternative<bool*>(r.field)) {
       valid = "true, false";
-    } else if (std::holds_alternative<std::string*>(r.field)) {
-      for (const auto& c : r.choices) valid += (valid.empty() ? "" : ", ") + c;
+    } else if (const auto* c = std::get_if<ChoiceField>(&r.field)) {
+      for (const auto n : c->names) valid += (valid.empty() ? "" : ", ") + std::string(n);
     } else {
       valid = describe_range(r);
     }

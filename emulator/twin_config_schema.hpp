@@ -6,34 +6,45 @@
 #include "drivers/json.hpp"
 
 
+#include <functional>
+#include <span>
 #include <stdexcept>
+#include <string_view>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "drivers/json_reader.hpp"
 #include "emulator/twin_config.hpp"
 
 namespace synbench::emulator {
 
-// A config problem, naming the key (dotted JSON path) and the reason.
+// A config problem: the JSON pointer of the key ("/synrm/rs_ohm"; "" for the document or the
+// file) and the reason. what() is "/synrm/rs_ohm: -1 is outside (0, inf]".
 class ConfigError : public std::runtime_error {
  public:
-  ConfigError(std::string key, std::string reason);
-  const std::string& key() const { return key_; }
-  const std::string& reason() const { return reason_; }
+  explicit ConfigError(drivers::JsonError error);
+  const std::string& pointer() const { return error_.pointer; }
+  const std::string& reason() const { return error_.reason; }
 
  private:
-  std::string key_;
-  std::string reason_;
+  drivers::JsonError error_;
+};
+
+// A string key with a fixed set of values, bound to an enum field: its names by value, and the
+// field read and written as the index into them.
+struct ChoiceField {
+  std::span<const std::string_view> names;
+  std::function<std::size_t()> get;
+  std::function<void(std::size_t)> set;
 };
 
 struct ParamRow {
   std::string key;  // dotted path, e.g. "synrm.rs_ohm"
-  std::variant<double*, int*, bool*, std::string*> field;
-  double min = 0;   // inclusive bounds for numbers; ignored for bool and string
+  std::variant<double*, int*, bool*, ChoiceField> field;
+  double min = 0;   // inclusive bounds for numbers; ignored for bool and choices
   double max = 0;
   bool min_exclusive = false;
-  std::vector<std::string> choices;  // allowed values of a string
   bool assumed = false;              // not in the thesis: our calibration
   std::string source;                // where the default comes from
   std::string doc;                   // what it is
@@ -43,7 +54,7 @@ struct ParamRow {
 std::vector<ParamRow> param_table(TwinConfig& config);
 
 // Overlays a (possibly partial) JSON document on `config`. Keys starting with '_' are comments.
-// Throws ConfigError naming the first bad key.
+// Throws ConfigError naming the first bad key by its JSON pointer.
 void apply_json(TwinConfig& config, const synbench::Json& doc);
 
 // Reads and applies a JSON file; a parse error names the file, line and column.

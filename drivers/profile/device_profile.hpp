@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "drivers/json_reader.hpp"
 #include "drivers/profile/register_codec.hpp"
 #include "drivers/profile/signal_catalogue.hpp"
 
@@ -120,12 +121,8 @@ struct DeviceProfile {
   const ProfileSignal* find(std::string_view signal) const;
 };
 
-// One validation problem: a JSON pointer into the profile document (RFC 6901, "" for the whole
-// document) and what is wrong there.
-struct ProfileError {
-  std::string path;
-  std::string reason;
-};
+// One validation problem: a JSON pointer into the profile document and what is wrong there.
+using ProfileError = JsonError;
 
 // Every problem is reported, not only the first, so a user fixes a profile in one pass.
 struct ProfileParseResult {
@@ -144,8 +141,5 @@ ProfileParseResult load_device_profile(const std::filesystem::path& file);
 std::filesystem::path default_profile_dir();
 // default_profile_dir() / "<kind>.json"
 std::filesystem::path default_profile_path(DeviceKind kind);
-
-// "a/b~c" -> "a~1b~0c": a signal name as one JSON pointer token.
-std::string json_pointer_token(std::string_view key);
 
 }  // namespace synbench::drivers

@@ -44,7 +44,7 @@ SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
       dead_time_V_per_V_(config.inverter.dead_time_compensation
                              ? config.inverter.dead_time_s * config.inverter.pwm_frequency_Hz
                              : 0.0),
-      pwm_(config.firmware.pwm == "aspwm" ? drivers::Pwm::aspwm : drivers::Pwm::capwm) {
+      pwm_(config.firmware.pwm) {
   const auto& f = cfg_.firmware;
   // Speed loop: crossover at the speed bandwidth for the bench inertia and the torque constant
   // at rated current and 45 deg (from the drive's own flux maps), PI zero a quarter below.

@@ -91,7 +91,7 @@ LoadedBench load_bench_or_throw(const std::string& file, const std::string& flag
   if (r.config) profiles = drivers::load_bench_profiles(*r.config, errors);
   if (!errors.empty() || !profiles) {
     std::string what;
-    for (const auto& e : errors) what += (what.empty() ? "" : "; ") + (e.path.empty() ? e.reason : e.path + ": " + e.reason);
+    for (const auto& e : errors) what += (what.empty() ? "" : "; ") + (e.pointer.empty() ? e.reason : e.pointer + ": " + e.reason);
     // A file that could not be read or parsed is named by the reader's own "FILE: reason".
     const bool names_file = !r.config && errors.size() == 1 && errors.front().reason.rfind(file + ": ", 0) == 0;
     throw UsageError(flag, names_file ? what : file + ": " + what);

@@ -5,8 +5,8 @@ namespace synbench::cli {
 
 std::string problem_text(const std::string& file, const drivers::ProfileError& e) {
   // A file that cannot be read or parsed is already named by the reader's own "FILE: reason".
-  if (e.path.empty() && e.reason.rfind(file + ":", 0) == 0) return e.reason;
-  return file + ": " + (e.path.empty() ? "" : e.path + ": ") + e.reason;
+  if (e.pointer.empty() && e.reason.rfind(file + ":", 0) == 0) return e.reason;
+  return file + ": " + (e.pointer.empty() ? "" : e.pointer + ": ") + e.reason;
 }
 
 void print_problems(std::ostream& out, const std::string& file, const std::vector<drivers::ProfileError>& errors) {

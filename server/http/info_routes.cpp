@@ -22,7 +22,7 @@ synbench::Json estimators_json(const emulator::TwinConfig& c) {
   };
   const synbench::Json eemf_range = {{"min_speed_rpm", e.eemf.min_speed_rpm},
                                      {"handover_hysteresis_rpm", e.eemf.handover_hysteresis_rpm},
-                                     {"low_speed_source", e.eemf.low_speed_source}};
+                                     {"low_speed_source", emulator::kLowSpeedSourceNames[static_cast<std::size_t>(e.eemf.low_speed_source)]}};
   add(drivers::Estimator::encoder, false, "incremental encoder: the reference", {{"min_speed_rpm", 0}});
   add(drivers::Estimator::ekf_basic, true, "EKF on the dq model: angle, speed, Ld, Lq", {{"min_speed_rpm", 0}});
   add(drivers::Estimator::ekf_rs, true, "EKF that also estimates the stator resistance",
@@ -58,7 +58,7 @@ synbench::Json profiles_json() {
     } else {
       j["valid"] = false;
       synbench::Json errors = synbench::Json::array();
-      for (const auto& e : parsed.errors) errors.push_back({{"path", e.path}, {"reason", e.reason}});
+      for (const auto& e : parsed.errors) errors.push_back({{"path", e.pointer}, {"reason", e.reason}});
       j["errors"] = errors;
     }
     out.push_back(std::move(j));

@@ -336,7 +336,7 @@ namespace {
 // the rotor there; the default vector error holds it.
 TEST(PointProcedure, ATripHeldFromThePreviousPointIsNotTheNextPointsLockLoss) {
   emulator::TwinConfig cfg;
-  cfg.estimators.eemf.error_signal = "direction";
+  cfg.estimators.eemf.error_signal = emulator::EemfErrorSignal::direction;
   emulator::TwinBench bench{cfg};
   PointOptions opt;
   opt.ordered_stop_after = false;

@@ -37,7 +37,7 @@ std::vector<std::string> error_pointers(const json& doc) {
   const auto r = parse_sweep_plan(doc);
   EXPECT_FALSE(r.plan.has_value());
   std::vector<std::string> out;
-  for (const auto& e : r.errors) out.push_back(e.json_pointer);
+  for (const auto& e : r.errors) out.push_back(e.pointer);
   return out;
 }
 
@@ -323,7 +323,7 @@ TEST(SweepPlanParse, AllErrorsAreReportedNotOnlyTheFirst) {
   })"));
   ASSERT_FALSE(r.plan);
   std::vector<std::string> ptrs;
-  for (const auto& e : r.errors) ptrs.push_back(e.json_pointer);
+  for (const auto& e : r.errors) ptrs.push_back(e.pointer);
   EXPECT_EQ(ptrs, (std::vector<std::string>{"/colour", "/order", "/dimensions/speed_rpm/1", "/dimensions/load_Nm/to",
                                             "/dimensions/angle_deg/0", "/window_s"}));
 }

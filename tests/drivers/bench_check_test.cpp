@@ -37,7 +37,7 @@ TEST(BenchCheck, DistinctUnitsOrLinksPass) {
 TEST(BenchCheck, CollidingRegistersOnOneLinkNameBothSignals) {
   const auto errors = check(config("b", 1), false);
   ASSERT_EQ(errors.size(), 1u);
-  EXPECT_EQ(errors[0].path, "/devices/load_drive/profile");
+  EXPECT_EQ(errors[0].pointer, "/devices/load_drive/profile");
   // Coil 0 is `enable` on both drives.
   EXPECT_NE(errors[0].reason.find("signal 'enable' (coil 0 at unit id 1) overlaps synrm_drive's signal 'enable'"),
             std::string::npos)
@@ -48,7 +48,7 @@ TEST(BenchCheck, CollidingRegistersOnOneLinkNameBothSignals) {
 TEST(BenchCheck, OneEndpointSeesEveryDevice) {
   const auto errors = check(config("b", 2), true);
   ASSERT_EQ(errors.size(), 1u);
-  EXPECT_EQ(errors[0].path, "/devices/vfc_meter/profile");
+  EXPECT_EQ(errors[0].pointer, "/devices/vfc_meter/profile");
   EXPECT_NE(errors[0].reason.find("on the one endpoint"), std::string::npos) << errors[0].reason;
 }
 
@@ -58,7 +58,7 @@ TEST(BenchCheck, OneSerialPortIsOneLink) {
   doc["links"]["b"] = {{"transport", "rtu"}, {"device", "/dev/ttyUSB0"}};
   const auto errors = check(doc, false);
   ASSERT_EQ(errors.size(), 1u);
-  EXPECT_EQ(errors[0].path, "/links/b/device");
+  EXPECT_EQ(errors[0].pointer, "/links/b/device");
   EXPECT_NE(errors[0].reason.find("is also link 'a'"), std::string::npos);
 }
 

@@ -25,7 +25,7 @@ namespace {
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
-  for (const ProfileError& e : errors) s += "\n  '" + e.path + "': " + e.reason;
+  for (const ProfileError& e : errors) s += "\n  '" + e.pointer + "': " + e.reason;
   return s;
 }
 

@@ -23,7 +23,7 @@ json default_doc(DeviceKind kind) {
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
-  for (const ProfileError& e : errors) s += "\n  '" + e.path + "': " + e.reason;
+  for (const ProfileError& e : errors) s += "\n  '" + e.pointer + "': " + e.reason;
   return s;
 }
 
@@ -173,7 +173,7 @@ TEST_P(InvalidProfile, IsRejectedOnceAtItsJsonPointer) {
   const ProfileParseResult r = parse_device_profile(doc);
   EXPECT_FALSE(r.profile.has_value());
   ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].path, c.path) << describe(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, c.path) << describe(r.errors);
   EXPECT_NE(r.errors[0].reason.find(c.reason_contains), std::string::npos) << describe(r.errors);
 }
 
@@ -187,15 +187,15 @@ TEST(DeviceProfile, ReportsEveryProblemInOnePass) {
   doc["signals"].erase("counts_g");
   const ProfileParseResult r = parse_device_profile(doc);
   ASSERT_EQ(r.errors.size(), 3u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].path, "/signals/gate_s/type");
-  EXPECT_EQ(r.errors[1].path, "/signals/idcm_A/scale");
-  EXPECT_EQ(r.errors[2].path, "/signals/counts_g");
+  EXPECT_EQ(r.errors[0].pointer, "/signals/gate_s/type");
+  EXPECT_EQ(r.errors[1].pointer, "/signals/idcm_A/scale");
+  EXPECT_EQ(r.errors[2].pointer, "/signals/counts_g");
 }
 
 TEST(DeviceProfile, NotAnObject) {
   const ProfileParseResult r = parse_device_profile(json::array());
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0].path, "");
+  EXPECT_EQ(r.errors[0].pointer, "");
 }
 
 // The smallest valid vfc_meter profile, written out so the defaults below are visible.
@@ -294,13 +294,13 @@ TEST(DeviceProfile, AdjacentSignalsDoNotOverlap) {
   doc["signals"]["idcm_A"]["address"] = 3;
   const ProfileParseResult r = parse_device_profile(doc);
   ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].path, "/signals/idcm_A/address");
+  EXPECT_EQ(r.errors[0].pointer, "/signals/idcm_A/address");
 }
 
 TEST(DeviceProfile, LoadReportsUnreadableAndMalformedFiles) {
   ProfileParseResult r = load_device_profile("/nonexistent/profile.json");
   ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0].path, "");
+  EXPECT_EQ(r.errors[0].pointer, "");
   EXPECT_NE(r.errors[0].reason.find("cannot open"), std::string::npos);
 
   const std::string bad = testing::TempDir() + "synbench_bad_profile.json";

@@ -24,7 +24,7 @@ json host_window_synrm() {
 
 DeviceProfile parse(const json& doc) {
   ProfileParseResult r = parse_device_profile(doc);
-  if (!r.profile) throw std::runtime_error(r.errors.front().path + ": " + r.errors.front().reason);
+  if (!r.profile) throw std::runtime_error(r.errors.front().pointer + ": " + r.errors.front().reason);
   return *r.profile;
 }
 

@@ -28,7 +28,7 @@ struct TempDir {
 
 std::string dump(const ProfileDirResult& r) {
   std::string s;
-  for (const auto& e : r.errors) s += e.file + ": " + e.error.path + ": " + e.error.reason + "\n";
+  for (const auto& e : r.errors) s += e.file + ": " + e.error.pointer + ": " + e.error.reason + "\n";
   return s;
 }
 

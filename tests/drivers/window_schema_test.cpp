@@ -22,7 +22,7 @@ json test_doc(const char* file) { return doc_of(std::filesystem::path(SYNBENCH_T
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
-  for (const ProfileError& e : errors) s += "\n  '" + e.path + "': " + e.reason;
+  for (const ProfileError& e : errors) s += "\n  '" + e.pointer + "': " + e.reason;
   return s;
 }
 
@@ -30,7 +30,7 @@ std::string describe(const std::vector<ProfileError>& errors) {
 void expect_error(const json& doc, const std::string& path, const std::string& reason) {
   const ProfileParseResult r = parse_device_profile(doc);
   ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].path, path);
+  EXPECT_EQ(r.errors[0].pointer, path);
   EXPECT_NE(r.errors[0].reason.find(reason), std::string::npos) << r.errors[0].reason;
 }
 
@@ -84,7 +84,7 @@ TEST(WindowSchema, AWindowResultWithoutTheDeviceWindowIsRefused) {
   // window_torque_Nm is a member of the load drive's group: the group is now half mapped.
   const ProfileParseResult r = parse_device_profile(d);
   ASSERT_FALSE(r.errors.empty());
-  EXPECT_EQ(r.errors[0].path, "/signals/window_status") << describe(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, "/signals/window_status") << describe(r.errors);
   json s = test_doc("synrm_host_window.json");
   s["signals"]["window_im_A"] = {{"register", "input"}, {"address", 110}, {"type", "f32"}, {"unit", "A"}};
   expect_error(s, "/signals/window_im_A", "a window result needs the device's window");

@@ -137,7 +137,7 @@ TEST(ClosedLoopEstimators, EemfConstErrsMostAndExactTablesHelp) {
   cfg.estimators.eemf.lut_lq_scale = 1.0;
   cfg.estimators.eemf.lut_ld_scale = 1.25;
   const auto lut_ld = position_errors_700(drivers::Estimator::eemf_lut, cfg);
-  cfg.estimators.eemf.error_signal = "direction";
+  cfg.estimators.eemf.error_signal = emulator::EemfErrorSignal::direction;
   const auto lut_ld_direction = position_errors_700(drivers::Estimator::eemf_lut, cfg);
   for (const auto& [name, r] : {std::pair{"EEMF-CONST", konst}, std::pair{"EEMF-LUT", lut},
                                 std::pair{"EKF-BASIC", ekf}, std::pair{"EEMF-LUT Lq x1.25", lut_lq},
@@ -210,7 +210,7 @@ ChainedLock chained_lut_700(const emulator::TwinConfig& cfg, std::initializer_li
 // it loses the rotor above the MTPA angle.
 emulator::TwinConfig direction_only() {
   emulator::TwinConfig cfg;
-  cfg.estimators.eemf.error_signal = "direction";
+  cfg.estimators.eemf.error_signal = emulator::EemfErrorSignal::direction;
   return cfg;
 }
 
@@ -246,7 +246,7 @@ TEST(ClosedLoopEstimators, EemfLutOnTheDirectionWithLdTimes125LosesLockAtLowerCu
 // current angles (at 700 rpm in the thesis sweep it ends 6 to 10 deg higher; docs/estimators.md).
 TEST(ClosedLoopEstimators, EemfLutOnTheActiveFluxSpeedHoldsLockToHigherCurrentAngles) {
   emulator::TwinConfig flux = direction_only();
-  flux.estimators.eemf.lut_rotation_speed = "active-flux";
+  flux.estimators.eemf.lut_rotation_speed = emulator::LutRotationSpeed::active_flux;
   const auto thesis = chained_lut_700(direction_only(), {1.0, 2.0, 3.0}, {62.0, 64.0, 66.0, 68.0});
   const auto active = chained_lut_700(flux, {1.0, 2.0, 3.0}, {62.0, 64.0, 66.0, 68.0});
   std::printf("700 rpm chained EEMF-LUT at 62..68 deg, direction only: lock lost at %d of %d points "
@@ -460,7 +460,7 @@ TEST(ClosedLoopEstimators, AnEemfPointWhollyOnItsEncoderFallbackHasNoPositionErr
 TEST(ClosedLoopEstimators, TheLockGuardHandsBackOnceTheNewSetpointsAreReached) {
   // The thesis' direction-only observer, which loses EEMF-LUT's rotor at 76 deg.
   emulator::TwinConfig cfg;
-  cfg.estimators.eemf.error_signal = "direction";
+  cfg.estimators.eemf.error_signal = emulator::EemfErrorSignal::direction;
   emulator::Twin tw{cfg};
   auto& d = tw.synrm_drive();
   ASSERT_NO_FATAL_FAILURE(lose_the_rotor_at_76_deg(tw, drivers::Estimator::eemf_lut, 500, 2.0));

@@ -14,7 +14,7 @@ std::string error_key(const synbench::Json& doc) {
   try {
     apply_json(c, doc);
   } catch (const ConfigError& e) {
-    return e.key() + " | " + e.reason();
+    return e.pointer() + " | " + e.reason();
   }
   return "no error";
 }
@@ -28,18 +28,18 @@ TEST(TwinConfig, PartialOverlayChangesOnlyTheNamedKeys) {
 }
 
 TEST(TwinConfig, ErrorsNameTheKeyAndTheReason) {
-  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohms": 1}})")), "synrm.rs_ohms | unknown key");
-  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": "9"}})")), "synrm.rs_ohm | must be a number");
-  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": -1}})")), "synrm.rs_ohm | -1 is outside (0, inf]");
-  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"pole_pairs": 2.5}})")), "synrm.pole_pairs | must be an integer");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohms": 1}})")), "/synrm/rs_ohms | unknown field");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": "9"}})")), "/synrm/rs_ohm | must be a finite number");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"rs_ohm": -1}})")), "/synrm/rs_ohm | -1 is outside (0, inf]");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"synrm": {"pole_pairs": 2.5}})")), "/synrm/pole_pairs | must be an integer in 1..32");
   EXPECT_EQ(error_key(synbench::Json::parse(R"({"firmware": {"pwm": "spwm"}})")),
-            "firmware.pwm | 'spwm' is not one of: capwm, aspwm");
+            "/firmware/pwm | unknown pwm 'spwm' (expected capwm, aspwm)");
   EXPECT_EQ(error_key(synbench::Json::parse(R"({"inverter": {"dead_time_compensation": 1}})")),
-            "inverter.dead_time_compensation | must be true or false");
+            "/inverter/dead_time_compensation | must be true or false");
   EXPECT_EQ(error_key(synbench::Json::parse(R"({"dc_bus": {"brake_off_V": 445}})")),
-            "dc_bus.brake_off_V | must be below dc_bus.brake_on_V");
-  EXPECT_EQ(error_key(synbench::Json::parse(R"({"nonsense": {}})")), "nonsense | unknown key");
-  EXPECT_EQ(error_key(synbench::Json::parse(R"([1, 2])")), "(root) | must be a JSON object");
+            "/dc_bus/brake_off_V | must be below dc_bus.brake_on_V");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"({"nonsense": {}})")), "/nonsense | unknown field");
+  EXPECT_EQ(error_key(synbench::Json::parse(R"([1, 2])")), " | the document must be a JSON object");
   // Comments (keys starting with '_') are allowed anywhere.
   EXPECT_EQ(error_key(synbench::Json::parse(R"({"_note": "x", "synrm": {"_assumed": ["b2"]}})")), "no error");
 }

@@ -32,7 +32,7 @@ void run_to_point(Twin& t, double speed, double load, double angle, Pwm pwm, Est
 }
 
 void BM_TwinStep(benchmark::State& state, Pwm pwm, Estimator e, double load_Nm = 2.5,
-                 const char* lut_rotation_speed = "observer") {
+                 synbench::emulator::LutRotationSpeed lut_rotation_speed = synbench::emulator::LutRotationSpeed::observer) {
   TwinConfig cfg;
   cfg.estimators.eemf.lut_rotation_speed = lut_rotation_speed;
   Twin t{cfg};
@@ -53,7 +53,7 @@ BENCHMARK_CAPTURE(BM_TwinStep, ekf_rs_aspwm, Pwm::aspwm, Estimator::ekf_rs);
 BENCHMARK_CAPTURE(BM_TwinStep, hfi_capwm, Pwm::capwm, Estimator::hfi);
 BENCHMARK_CAPTURE(BM_TwinStep, eemf_lut_capwm, Pwm::capwm, Estimator::eemf_lut);
 BENCHMARK_CAPTURE(BM_TwinStep, eemf_lut_active_flux_capwm, Pwm::capwm, Estimator::eemf_lut, 2.5,
-                  "active-flux");
+                  synbench::emulator::LutRotationSpeed::active_flux);
 // EEMF-RLS holds the rotor at light load only (docs/estimators.md).
 BENCHMARK_CAPTURE(BM_TwinStep, eemf_rls_capwm_0_5Nm, Pwm::capwm, Estimator::eemf_rls, 0.5);
 

@@ -55,12 +55,12 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   p.stiffness.margin = e.stiffness_margin;
   p.speed_filter_s = e.speed_filter_s;
   // The active flux needs the machine's q flux: only the tables have it (active_flux_speed.hpp).
-  p.rotation_speed = model == EemfModel::lut && e.lut_rotation_speed == "active-flux"
+  p.rotation_speed = model == EemfModel::lut && e.lut_rotation_speed == LutRotationSpeed::active_flux
                          ? EemfRotationSpeed::active_flux
                          : EemfRotationSpeed::observer;
   // The magnitude needs a model of it: the tables have one, the RLS its slope (scaled to the
   // measurement), the constants neither (emf_angle_error.hpp).
-  p.vector_error = model != EemfModel::constant && e.error_signal == "vector";
+  p.vector_error = model != EemfModel::constant && e.error_signal == EemfErrorSignal::vector;
   p.emf_scale_filter_s = model == EemfModel::rls ? e.rls_emf_scale_filter_s : 0.0;
   p.flux_speed.blend_rad_s = e.flux_blend_rad_s;
   p.flux_speed.speed_filter_s = e.flux_speed_filter_s;
@@ -76,7 +76,7 @@ std::unique_ptr<Estimator> make_eemf(const TwinConfig& config, EemfModel model) 
   const double w_min = e.min_speed_rpm * kRadSPerRpm * config.synrm.pole_pairs;
   const double w_hyst = e.handover_hysteresis_rpm * kRadSPerRpm * config.synrm.pole_pairs;
   return std::make_unique<LowSpeedHandover>(
-      std::make_unique<Eemf>(p), e.low_speed_source == "hfi" ? make_hfi(config) : nullptr, w_min,
+      std::make_unique<Eemf>(p), e.low_speed_source == LowSpeedSource::hfi ? make_hfi(config) : nullptr, w_min,
       w_hyst, config.firmware.lock_guard_deg * kPi / 180.0, p.ts_s);
 }
 

@@ -21,7 +21,7 @@ using testing::vendor_synrm;
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
-  for (const ProfileError& e : errors) s += "\n  '" + e.path + "': " + e.reason;
+  for (const ProfileError& e : errors) s += "\n  '" + e.pointer + "': " + e.reason;
   return s;
 }
 
@@ -30,7 +30,7 @@ void expect_refused(const json& doc, const std::string& path, const std::string&
   const auto r = parse_device_profile(doc);
   ASSERT_FALSE(r.profile);
   ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].path, path) << describe(r.errors);
+  EXPECT_EQ(r.errors[0].pointer, path) << describe(r.errors);
   EXPECT_NE(r.errors[0].reason.find(reason), std::string::npos) << describe(r.errors);
 }
 
@@ -197,7 +197,7 @@ TEST(ProfileBits, MistakesAreRefusedAtTheirPointers) {
     EXPECT_EQ(r.errors.size(), 3u) << describe(r.errors);
     // Reported at the later signal of each pair, in the document's order.
     for (const ProfileError& e : r.errors)
-      EXPECT_TRUE(e.path == "/signals/angle_setpoint_deg/address" ||
+      EXPECT_TRUE(e.pointer == "/signals/angle_setpoint_deg/address" ||
                   e.reason.find("overlaps 'angle_setpoint_deg' (holding 40..40, unit id 1)") != std::string::npos)
           << describe(r.errors);
   }
@@ -214,7 +214,7 @@ TEST(ProfileBits, MistakesAreRefusedAtTheirPointers) {
   expect_refused(with([](json& d) { d["signals"]["speed_rpm"]["otherwise"] = "running"; }),
                  "/signals/speed_rpm/otherwise", "not an enumerated signal");
   expect_refused(with([](json& d) { d["signals"]["fault_reset"]["reset"] = {{"mode", "edge"}}; }),
-                 "/signals/fault_reset/reset/mode", "unknown reset mode 'edge' (expected pulse, level)");
+                 "/signals/fault_reset/reset/mode", "unknown reset mode 'edge' (expected level, pulse)");
   expect_refused(with([](json& d) { d["signals"]["fault_reset"]["reset"] = {{"mode", "pulse"}}; }),
                  "/signals/fault_reset/reset/pulse_ms", "required");
   expect_refused(with([](json& d) { d["signals"]["fault_reset"]["reset"] = {{"mode", "level"}, {"pulse_ms", 5}}; }),

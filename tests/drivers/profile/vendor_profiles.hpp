@@ -23,7 +23,7 @@ inline drivers::DeviceProfile parse_or_throw(const synbench::Json& doc) {
   auto r = drivers::parse_device_profile(doc);
   if (!r.profile) {
     std::string why;
-    for (const auto& e : r.errors) why += " '" + e.path + "': " + e.reason;
+    for (const auto& e : r.errors) why += " '" + e.pointer + "': " + e.reason;
     throw std::runtime_error("test profile refused:" + why);
   }
   return *r.profile;

@@ -23,7 +23,7 @@ using testing::FakeBus;
 
 DeviceProfile test_profile(const char* file) {
   ProfileParseResult r = load_device_profile(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / file);
-  if (!r.profile) throw std::runtime_error(std::string(file) + ": " + r.errors.front().path + ": " + r.errors.front().reason);
+  if (!r.profile) throw std::runtime_error(std::string(file) + ": " + r.errors.front().pointer + ": " + r.errors.front().reason);
   return *r.profile;
 }
 
