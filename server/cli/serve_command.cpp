@@ -114,7 +114,7 @@ int serve_command(const std::vector<std::string>& argv) {
 
   http::TokenStore tokens(data_dir / "tokens.json");
   if (auto e = tokens.load()) {
-    std::cerr << "synbench serve: " << tokens.file().string() << " is unreadable: " << e.message() << "\n";
+    std::cerr << "synbench serve: " << tokens.file().string() << " is unreadable: " << tokens.load_error() << "\n";
     return 1;
   }
   if (tokens.empty()) {

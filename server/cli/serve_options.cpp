@@ -2,11 +2,11 @@
 #include "server/cli/serve_options.hpp"
 
 #include <cstdlib>
-#include <set>
 
 #include "drivers/json.hpp"
 
 #include "drivers/json_file.hpp"
+#include "drivers/json_reader.hpp"
 #include "emulator/twin_config_schema.hpp"
 #include "server/cli/args.hpp"
 
@@ -32,6 +32,20 @@ std::vector<std::string> split_list(const std::string& list) {
   return out;
 }
 
+// Empty when `text` is an origin ("scheme://host[:port]", no path), else the reason.
+std::string origin_problem(const std::string& text) {
+  const auto sep = text.find("://");
+  const bool ok = sep != std::string::npos && (text.substr(0, sep) == "http" || text.substr(0, sep) == "https") &&
+                  sep + 3 < text.size() && text.find_first_of("/?# ", sep + 3) == std::string::npos;
+  return ok ? std::string() : "'" + text + "' is not an origin (scheme://host[:port], no path)";
+}
+
+// Empty when `text` is a Host header value, else the reason.
+std::string host_value_problem(const std::string& text) {
+  const bool ok = !text.empty() && text.find_first_of("/?# @") == std::string::npos && text.find("://") == std::string::npos;
+  return ok ? std::string() : "'" + text + "' is not a Host header value (name:port, e.g. bench-pc.lab:8080)";
+}
+
 // The daemon config file: every key optional, unknown keys rejected, paths relative to the file.
 struct FileSettings {
   std::optional<std::string> listen;
@@ -42,64 +56,56 @@ struct FileSettings {
   std::vector<std::string> allow_hosts, allow_origins;
 };
 
+// Reads the whole file through the JSON reader, so one UsageError names every problem at its
+// JSON pointer ("--config: FILE: /lissten: unknown field; /allow_hosts/1: must be a string").
 FileSettings read_config_file(const std::filesystem::path& file, const std::string& flag) {
   // "cannot read PATH: cannot open: No such file or directory", "cannot read PATH: not valid JSON: ..."
   drivers::JsonParsed read = drivers::read_json_file(file);
   if (!read.ok()) throw UsageError(flag, "cannot read " + read.error);
-  const synbench::Json& doc = read.doc;
-  if (!doc.is_object()) throw UsageError(flag, file.string() + ": the top level must be an object");
-  const auto base = file.parent_path();
-  const auto at = [&](const std::string& key, const std::string& reason) {
-    return UsageError(flag, file.string() + ": /" + key + ": " + reason);
-  };
-  const auto text = [&](const std::string& key) {
-    const auto& v = doc[key];
-    if (!v.is_string() || v.get<std::string>().empty()) throw at(key, "must be a non-empty string");
-    return v.get<std::string>();
-  };
-  const auto path = [&](const std::string& key) {
-    std::filesystem::path p = text(key);
-    return p.is_absolute() ? p : base / p;
-  };
-  const auto strings = [&](const std::string& key) {
-    const auto& v = doc[key];
-    if (!v.is_array()) throw at(key, "must be a list of strings");
-    std::vector<std::string> out;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      if (!v[i].is_string()) throw at(key + "/" + std::to_string(i), "must be a string");
-      out.push_back(v[i].get<std::string>());
-    }
-    return out;
-  };
-  static const std::set<std::string> known{"listen",      "data_dir",      "web_dir", "bench", "twin", "allow_hosts",
-                                           "allow_origins", "allow_remote_plain_http"};
+  drivers::JsonReader reader;
+  const drivers::JsonNode doc = drivers::read_root(read.doc, reader);
   FileSettings s;
-  for (const auto& [key, value] : doc.items()) {
-    if (!key.empty() && key.front() == '_') continue;  // comments, as in config/twin.json
-    if (!known.count(key)) {
-      std::string list;
-      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      throw at(key, "unknown key (expected: " + list + ")");
+  if (doc.object()) {
+    doc.reject_unknown({"listen", "data_dir", "web_dir", "bench", "twin", "allow_hosts", "allow_origins",
+                        "allow_remote_plain_http"});
+    const auto base = file.parent_path();
+    const auto path = [&](std::string_view key) -> std::optional<std::filesystem::path> {
+      const auto t = doc[key].text(true);
+      if (!t) return std::nullopt;
+      std::filesystem::path p = *t;
+      return p.is_absolute() ? p : base / p;
+    };
+    // A list of strings, each lower-cased and checked by `problem`, reported at its own element.
+    const auto strings = [&](std::string_view key, std::string (*problem)(const std::string&)) {
+      std::vector<std::string> out;
+      const auto items = doc[key].list("must be a list of strings");
+      if (!items) return out;
+      for (const auto& item : *items) {
+        auto t = item.text();
+        if (!t) continue;
+        *t = lower(*t);
+        if (auto reason = problem(*t); !reason.empty()) item.fail(std::move(reason));
+        else out.push_back(std::move(*t));
+      }
+      return out;
+    };
+    s.listen = doc["listen"].text(true);
+    s.allow_remote_plain_http = doc["allow_remote_plain_http"].boolean().value_or(false);
+    s.data_dir = path("data_dir");
+    s.web_dir = path("web_dir");
+    s.bench = path("bench");
+    if (const auto twin = doc["twin"]; twin.present()) {
+      if (twin.json().is_object()) s.twin = twin.json();
+      else if (twin.json().is_string()) s.twin_file = path("twin");
+      else twin.fail("must be a twin config object or a file name (docs/emulator-config.md)");
     }
+    s.allow_hosts = strings("allow_hosts", host_value_problem);
+    s.allow_origins = strings("allow_origins", origin_problem);
   }
-  if (doc.contains("listen")) s.listen = text("listen");
-  if (doc.contains("allow_remote_plain_http")) {
-    if (!doc["allow_remote_plain_http"].is_boolean()) throw at("allow_remote_plain_http", "must be true or false");
-    s.allow_remote_plain_http = doc["allow_remote_plain_http"].get<bool>();
-  }
-  if (doc.contains("data_dir")) s.data_dir = path("data_dir");
-  if (doc.contains("web_dir")) s.web_dir = path("web_dir");
-  if (doc.contains("bench")) s.bench = path("bench");
-  if (doc.contains("twin")) {
-    if (doc["twin"].is_object()) s.twin = doc["twin"];
-    else if (doc["twin"].is_string()) s.twin_file = path("twin");
-    else throw at("twin", "must be a twin config object or a file name (docs/emulator-config.md)");
-  }
-  if (doc.contains("allow_hosts")) {
-    for (auto& h : strings("allow_hosts")) s.allow_hosts.push_back(parse_host_value(h, flag + " " + file.string() + ": /allow_hosts"));
-  }
-  if (doc.contains("allow_origins")) {
-    for (auto& o : strings("allow_origins")) s.allow_origins.push_back(parse_origin(o, flag + " " + file.string() + ": /allow_origins"));
+  if (!reader.ok()) {
+    std::string all;
+    for (const auto& e : reader.errors) all += (all.empty() ? "" : "; ") + drivers::to_string(e);
+    throw UsageError(flag, file.string() + ": " + all);
   }
   return s;
 }
@@ -133,17 +139,13 @@ void parse_listen(const std::string& text, const std::string& what, std::string&
 
 std::string parse_origin(std::string text, const std::string& what) {
   text = lower(text);
-  const auto sep = text.find("://");
-  const bool ok = sep != std::string::npos && (text.substr(0, sep) == "http" || text.substr(0, sep) == "https") &&
-                  sep + 3 < text.size() && text.find_first_of("/?# ", sep + 3) == std::string::npos;
-  if (!ok) throw UsageError(what, "'" + text + "' is not an origin (scheme://host[:port], no path)");
+  if (auto reason = origin_problem(text); !reason.empty()) throw UsageError(what, reason);
   return text;
 }
 
 std::string parse_host_value(std::string text, const std::string& what) {
   text = lower(text);
-  const bool ok = !text.empty() && text.find_first_of("/?# @") == std::string::npos && text.find("://") == std::string::npos;
-  if (!ok) throw UsageError(what, "'" + text + "' is not a Host header value (name:port, e.g. bench-pc.lab:8080)");
+  if (auto reason = host_value_problem(text); !reason.empty()) throw UsageError(what, reason);
   return text;
 }
 

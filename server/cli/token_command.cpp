@@ -50,7 +50,9 @@ int token_command(const std::vector<std::string>& argv) {
   std::error_code ec;
   const std::string token = store.create(role, ec);
   if (ec) {
-    std::cerr << "synbench token: cannot update " << store.file().string() << ": " << ec.message() << "\n";
+    // A broken file says what is wrong at each JSON pointer; a failed write has only its errno.
+    const std::string why = store.load_error();
+    std::cerr << "synbench token: cannot update " << store.file().string() << ": " << (why.empty() ? ec.message() : why) << "\n";
     return 1;
   }
   std::cout << token << "\n";

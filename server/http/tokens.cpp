@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "drivers/json.hpp"
 
 #include "drivers/json_file.hpp"
+#include "drivers/json_reader.hpp"
 #include "server/http/sha256.hpp"
 
 namespace synbench::http {
@@ -70,6 +72,10 @@ std::error_code write_private_file(const std::filesystem::path& path, const std:
 
 namespace {
 
+// The roles a token may carry ("anyone" is no token at all), by index.
+constexpr std::array<std::string_view, 2> kTokenRoleNames{"viewer", "operator"};
+constexpr std::array<Role, 2> kTokenRoles{Role::viewer, Role::operator_};
+
 std::string utc_now() {
   const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
@@ -88,6 +94,7 @@ std::error_code TokenStore::load() {
 
 std::error_code TokenStore::load_locked() {
   std::error_code ec;
+  load_errors_.clear();
   if (!std::filesystem::exists(file_, ec)) {
     entries_.clear();
     return {};
@@ -96,28 +103,53 @@ std::error_code TokenStore::load_locked() {
   // are not UTF-8 or an overflowing number are a refusal, never an exception.
   const drivers::JsonParsed read = drivers::read_json_file(file_);
   if (!read.ok()) {
+    load_errors_.push_back({"", read.error});
     std::error_code type_ec;
     if (std::filesystem::is_directory(file_, type_ec)) return std::make_error_code(std::errc::is_a_directory);
     if (read.error.find(": cannot open: ") != std::string::npos) return std::make_error_code(std::errc::permission_denied);
     return std::make_error_code(std::errc::invalid_argument);
   }
-  const synbench::Json& doc = read.doc;
-  if (!doc.is_object() || !doc.contains("tokens") || !doc["tokens"].is_array())
-    return std::make_error_code(std::errc::invalid_argument);
+  // Every problem at once, each at its JSON pointer, in the wording of the other loaders.
+  drivers::JsonReader reader;
+  const drivers::JsonNode doc = drivers::read_root(read.doc, reader);
   std::vector<TokenEntry> entries;
-  for (const auto& t : doc["tokens"]) {
-    if (!t.is_object() || !t.contains("sha256") || !t["sha256"].is_string() || !t.contains("role") || !t["role"].is_string())
-      return std::make_error_code(std::errc::invalid_argument);
-    const auto role = parse_role(t["role"].get<std::string>());
-    if (!role) return std::make_error_code(std::errc::invalid_argument);
-    // value() would throw on a "created" that is not a string; the field is informative only.
-    const auto created = t.find("created");
-    entries.push_back({t["sha256"].get<std::string>(), *role,
-                       created != t.end() && created->is_string() ? created->get<std::string>() : std::string()});
+  if (doc.object()) {
+    doc.reject_unknown({"tokens"});
+    if (const auto tokens = doc["tokens"].required().list()) {
+      for (const auto& t : *tokens) {
+        if (!t.object()) continue;
+        t.reject_unknown({"sha256", "role", "created"});
+        auto sha = t["sha256"].required().text(true);
+        if (sha && (sha->size() != 64 || sha->find_first_not_of("0123456789abcdef") != std::string::npos)) {
+          t["sha256"].fail("must be 64 lower-case hex digits (the token's SHA-256, never the token)");
+          sha.reset();
+        }
+        const auto role = t["role"].required().choice<std::size_t>(kTokenRoleNames, "role");
+        // "created" is informative only, but a wrong type is a mistake in the file like any other.
+        const auto created = t["created"].text();
+        if (sha && role) entries.push_back({*sha, kTokenRoles[*role], created.value_or(std::string())});
+      }
+    }
+  }
+  if (!reader.ok()) {
+    load_errors_ = std::move(reader.errors);
+    return std::make_error_code(std::errc::invalid_argument);
   }
   entries_ = std::move(entries);
   loaded_mtime_ = std::filesystem::last_write_time(file_, ec);
   return {};
+}
+
+std::string TokenStore::load_error() const {
+  std::lock_guard lock(mutex_);
+  std::string all;
+  for (const auto& e : load_errors_) all += (all.empty() ? "" : "; ") + (e.pointer.empty() ? e.reason : drivers::to_string(e));
+  return all;
+}
+
+std::vector<drivers::JsonError> TokenStore::load_errors() const {
+  std::lock_guard lock(mutex_);
+  return load_errors_;
 }
 
 bool TokenStore::empty() const {

@@ -11,6 +11,7 @@
 #include <system_error>
 #include <vector>
 
+#include "drivers/json_reader.hpp"
 #include "server/http/router.hpp"
 
 namespace synbench::http {
@@ -28,8 +29,12 @@ class TokenStore {
   // Creates a token of `role`, appends its digest to the file (0600, written atomically) and
   // returns the token: the only time it exists in clear.
   std::string create(Role role, std::error_code& ec);
-  // Loads the file; a missing file is an empty store.
+  // Loads the file; a missing file is an empty store. A broken file keeps the tokens loaded
+  // before and says why in load_errors(): every problem at its JSON pointer.
   std::error_code load();
+  std::vector<drivers::JsonError> load_errors() const;
+  // The same, joined with "; " ("/tokens/0/role: unknown role 'admin' (expected viewer, operator)").
+  std::string load_error() const;
   bool empty() const;
   // Role of `token` and its label ("token-" + 8 digits of its digest), or nullopt. Reloads the
   // file first when its modification time changed.
@@ -41,6 +46,7 @@ class TokenStore {
   std::filesystem::path file_;
   mutable std::mutex mutex_;
   std::vector<TokenEntry> entries_;
+  std::vector<drivers::JsonError> load_errors_;
   std::filesystem::file_time_type loaded_mtime_{};
 };
 

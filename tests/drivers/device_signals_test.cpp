@@ -27,7 +27,7 @@ json doc_of(const std::filesystem::path& p) {
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
-  for (const ProfileError& e : errors) s += "\n  '" + e.path + "': " + e.reason;
+  for (const ProfileError& e : errors) s += "\n  '" + e.pointer + "': " + e.reason;
   return s;
 }
 
@@ -126,7 +126,7 @@ TEST(DeviceSignals, TheWindowSchemaTakesADrivesWindowTableSignalsAsWindowSignals
       EXPECT_FALSE(r.profile) << keep;
       bool named = false;
       for (const ProfileError& e : r.errors)
-        named = named || e.path == "/signals/" + std::string(keep) || e.reason.find(keep) != std::string::npos;
+        named = named || e.pointer == "/signals/" + std::string(keep) || e.reason.find(keep) != std::string::npos;
       EXPECT_TRUE(named) << keep << describe(r.errors);
     }
   };
@@ -143,7 +143,7 @@ TEST(DeviceSignals, TheWindowSchemaRequiresAMeterTablesSignalsForItsMeterKind) {
       doc["signals"].erase(std::string(s));
       const ProfileParseResult r = parse_device_profile(doc);
       ASSERT_EQ(r.errors.size(), 1u) << s << describe(r.errors);
-      EXPECT_EQ(r.errors[0].path, "/signals/" + std::string(s));
+      EXPECT_EQ(r.errors[0].pointer, "/signals/" + std::string(s));
       EXPECT_NE(r.errors[0].reason.find("for meter " + meter), std::string::npos) << r.errors[0].reason;
     }
   };

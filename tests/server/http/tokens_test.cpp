@@ -90,6 +90,51 @@ TEST(Tokens, BrokenFileIsAnError) {
   std::ofstream(dir / "tokens.json") << "{not json";
   TokenStore store(dir / "tokens.json");
   EXPECT_TRUE(store.load());
+  EXPECT_NE(store.load_error().find("not valid JSON"), std::string::npos) << store.load_error();
+  std::filesystem::remove_all(dir);
+}
+
+// Three mistakes in one tokens file: all three reported, each at its JSON pointer; the store
+// keeps the tokens it had and authenticates none from the broken file.
+TEST(Tokens, BrokenFileNamesEveryMistakeAtItsPointer) {
+  const auto dir = temp_dir();
+  const std::string good(64, 'a');
+  std::ofstream(dir / "tokens.json") << R"({"tokens": [{"sha256": ")" << good << R"(", "role": "admin"},
+    {"role": "viewer", "_note": "fine"}, {"sha256": "sbt_cleartext", "role": "operator", "expires": 1}]})";
+  TokenStore store(dir / "tokens.json");
+  EXPECT_EQ(store.load(), std::make_error_code(std::errc::invalid_argument));
+  const std::vector<drivers::JsonError> want{
+      {"/tokens/0/role", "unknown role 'admin' (expected viewer, operator)"},
+      {"/tokens/1/sha256", "required field is missing"},
+      {"/tokens/2/expires", "unknown field"},
+      {"/tokens/2/sha256", "must be 64 lower-case hex digits (the token's SHA-256, never the token)"},
+  };
+  EXPECT_EQ(store.load_errors(), want);
+  EXPECT_EQ(store.load_error().rfind("/tokens/0/role: unknown role 'admin' (expected viewer, operator); /tokens/1/", 0), 0u)
+      << store.load_error();
+  EXPECT_TRUE(store.empty());
+
+  std::ofstream(dir / "tokens.json") << R"({"token": []})";
+  EXPECT_TRUE(store.load());
+  const std::vector<drivers::JsonError> root{{"/token", "unknown field"}, {"/tokens", "required field is missing"}};
+  EXPECT_EQ(store.load_errors(), root);
+  std::filesystem::remove_all(dir);
+}
+
+// A good file loads with no errors left from a broken one before.
+TEST(Tokens, GoodFileClearsTheErrors) {
+  const auto dir = temp_dir();
+  std::ofstream(dir / "tokens.json") << R"({"tokens": 5})";
+  TokenStore store(dir / "tokens.json");
+  EXPECT_TRUE(store.load());
+  EXPECT_EQ(store.load_error(), "/tokens: must be a list");
+  std::error_code ec;
+  std::filesystem::remove(dir / "tokens.json");
+  const auto token = store.create(Role::viewer, ec);
+  ASSERT_FALSE(ec);
+  EXPECT_FALSE(store.load());
+  EXPECT_EQ(store.load_error(), "");
+  ASSERT_TRUE(store.authenticate(token));
   std::filesystem::remove_all(dir);
 }
 
