@@ -14,6 +14,14 @@ namespace synbench::bench {
 // vector, which has no angle.
 std::optional<double> current_angle_deg(double id_A, double iq_A);
 
+// The angles the bench commands: motoring, strictly between the d axis (no torque) and the q axis
+// (no torque either, and all reluctance flux on the weak axis). Sweep plans, the REST setpoints
+// and `synbench point --angle-deg` all hold a request to this one rule.
+inline constexpr double kMotoringAngleAbove_deg = 0, kMotoringAngleBelow_deg = 90;
+constexpr bool is_motoring_angle(double angle_deg) {
+  return angle_deg > kMotoringAngleAbove_deg && angle_deg < kMotoringAngleBelow_deg;
+}
+
 // How far the measured angle may be from the request at a mean current vector of magnitude
 // `im_A` before the point is flagged `angle_off`; empty below kAngleJudgedFrom_A (not judged).
 // The current controller's integral action tracks the angle reference with no mean error, so a

@@ -3,21 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "drivers/error.hpp"
+#include "drivers/printf_text.hpp"
 
 namespace synbench::bench {
-namespace {
-
-std::string format(const char* fmt, double a, double b) {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, fmt, a, b);
-  return buf;
-}
-
-}  // namespace
-
 SafetyLimits stricter(const SafetyLimits& a, const SafetyLimits& b) {
   SafetyLimits l = a;
   l.max_speed_rpm = std::min(a.max_speed_rpm, b.max_speed_rpm);
@@ -209,7 +199,7 @@ void SafetySupervisor::tick(double now_s) {
   } else if (now_s - last_good_read_s_ > lim_.link_timeout_s) {
     // The drives' own watchdogs stop them; we still try the ordered stop.
     raise(now_s, drivers::Fault::link_loss,
-          format("no telemetry for %.2f s (limit %.2f s)", now_s - last_good_read_s_, lim_.link_timeout_s));
+          drivers::printf_text("no telemetry for %.2f s (limit %.2f s)", now_s - last_good_read_s_, lim_.link_timeout_s));
   }
 
   if (synrm_ && !trip_) {
@@ -220,15 +210,15 @@ void SafetySupervisor::tick(double now_s) {
     else if (s.fault != drivers::Fault::none)
       raise(now_s, s.fault, "SynRM drive reports its own trip");
     else if (std::fabs(s.speed_rpm) > lim_.max_speed_rpm)
-      raise(now_s, drivers::Fault::overspeed, format("speed %.0f rpm > %.0f rpm", std::fabs(s.speed_rpm), lim_.max_speed_rpm));
+      raise(now_s, drivers::Fault::overspeed, drivers::printf_text("speed %.0f rpm > %.0f rpm", std::fabs(s.speed_rpm), lim_.max_speed_rpm));
     else if (s.im_A > lim_.max_current_A)
-      raise(now_s, drivers::Fault::overcurrent, format("current %.2f A > %.2f A", s.im_A, lim_.max_current_A));
+      raise(now_s, drivers::Fault::overcurrent, drivers::printf_text("current %.2f A > %.2f A", s.im_A, lim_.max_current_A));
     else if (s.udc_V > lim_.max_udc_V)
-      raise(now_s, drivers::Fault::overvoltage, format("DC bus %.0f V > %.0f V", s.udc_V, lim_.max_udc_V));
+      raise(now_s, drivers::Fault::overvoltage, drivers::printf_text("DC bus %.0f V > %.0f V", s.udc_V, lim_.max_udc_V));
     else if (drivers::running(s.state) && s.udc_V < lim_.min_udc_V)
-      raise(now_s, drivers::Fault::undervoltage, format("DC bus %.0f V < %.0f V", s.udc_V, lim_.min_udc_V));
+      raise(now_s, drivers::Fault::undervoltage, drivers::printf_text("DC bus %.0f V < %.0f V", s.udc_V, lim_.min_udc_V));
     else if (s.temp_C && *s.temp_C > lim_.max_temp_C)
-      raise(now_s, drivers::Fault::overtemperature, format("winding %.1f degC > %.1f degC", *s.temp_C, lim_.max_temp_C));
+      raise(now_s, drivers::Fault::overtemperature, drivers::printf_text("winding %.1f degC > %.1f degC", *s.temp_C, lim_.max_temp_C));
   }
   if (load_ && !trip_ && load_->fault != drivers::Fault::none)
     raise(now_s, drivers::Fault::load_drive, "load drive reports " + drivers::describe_fault(load_->fault, load_->fault_code_raw),

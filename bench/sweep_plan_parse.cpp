@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "bench/current_angle.hpp"
 #include "bench/sweep_plan.hpp"
 #include "bench/sweep_presets.hpp"
 
@@ -62,7 +63,7 @@ Check non_negative_at_most(double hi, const std::string& what) {
 }
 Check angle_check() {
   return [](double v) {
-    return v > 0 && v < 90 ? std::string() : "must be inside (0, 90) deg (the motoring region)";
+    return is_motoring_angle(v) ? std::string() : "must be inside (0, 90) deg (the motoring region)";
   };
 }
 

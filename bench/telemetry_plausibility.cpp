@@ -2,17 +2,11 @@
 #include "bench/telemetry_plausibility.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <cstring>
+#include "drivers/printf_text.hpp"
 
 namespace synbench::bench {
 namespace {
-
-std::string format(const char* fmt, double a, double b, double c = 0) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, fmt, a, b, c);
-  return buf;
-}
 
 std::uint64_t bits_of(double v) {
   std::uint64_t b;
@@ -72,14 +66,14 @@ std::optional<Implausibility> TelemetryPlausibility::check(double now_s, const d
   // Signs and ranges hold whatever the state: a sensor does not read a negative magnitude
   // because the gates are off.
   if (std::isnan(t.im_A) || t.im_A < lim_.min_im_A)
-    return Implausibility{"im_A", format("%.3g A is negative: a current magnitude is never below %.3g A", t.im_A,
+    return Implausibility{"im_A", drivers::printf_text("%.3g A is negative: a current magnitude is never below %.3g A", t.im_A,
                                          lim_.min_im_A)};
   if (std::isnan(t.udc_V) || t.udc_V < lim_.min_udc_V)
-    return Implausibility{"udc_V", format("%.4g V is below %.3g V: the DC bus never reverses", t.udc_V,
+    return Implausibility{"udc_V", drivers::printf_text("%.4g V is below %.3g V: the DC bus never reverses", t.udc_V,
                                           lim_.min_udc_V)};
   // No sensor mapped is no reading, not a broken one.
   if (t.temp_C && (std::isnan(*t.temp_C) || *t.temp_C < lim_.min_temp_C || *t.temp_C > lim_.max_temp_C))
-    return Implausibility{"temp_C", format("%.4g degC is outside [%.4g, %.4g] degC: a broken winding sensor",
+    return Implausibility{"temp_C", drivers::printf_text("%.4g degC is outside [%.4g, %.4g] degC: a broken winding sensor",
                                            *t.temp_C, lim_.min_temp_C, lim_.max_temp_C)};
   if (std::isnan(t.speed_rpm))
     return Implausibility{"speed_rpm", "is not a number"};
@@ -103,7 +97,7 @@ std::optional<Implausibility> TelemetryPlausibility::check(double now_s, const d
   if (at_rest_since_s_ < 0) at_rest_since_s_ = now_s;
   if (now_s - at_rest_since_s_ >= lim_.rest_s)
     return Implausibility{"speed_rpm",
-                          format("%.3g rpm, the shaft at rest, with %.3g A flowing for %.2f s: a dead speed sensor or a "
+                          drivers::printf_text("%.3g rpm, the shaft at rest, with %.3g A flowing for %.2f s: a dead speed sensor or a "
                                  "locked rotor",
                                  t.speed_rpm, t.im_A, now_s - at_rest_since_s_)};
   return std::nullopt;

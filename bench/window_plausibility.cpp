@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "drivers/printf_text.hpp"
+
 namespace synbench::bench {
 namespace {
 
@@ -13,11 +15,7 @@ constexpr double kMagnitudeTolerance_A = 0.01;
 constexpr double kMinTemp_C = -30.0, kMaxTemp_C = 250.0;
 constexpr double kMinUdc_V = -5.0;
 
-std::string say(const char* field, const char* fmt, double a, double b = 0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, fmt, a, b);
-  return std::string(field) + ": " + buf;
-}
+std::string say(const char* field, const std::string& text) { return std::string(field) + ": " + text; }
 
 }  // namespace
 
@@ -37,9 +35,9 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
       {"idcm_A", meter.idcm_A},         {"idcg_A", meter.idcg_A},
   };
   for (const auto& f : finite)
-    if (!std::isfinite(f.value)) return say(f.field, "%g is not a finite number", f.value);
+    if (!std::isfinite(f.value)) return say(f.field, drivers::printf_text("%g is not a finite number", f.value));
   for (const auto& [field, value] : {std::pair{"pdcm_W", meter.pdcm_W}, std::pair{"pdcg_W", meter.pdcg_W}})
-    if (value && !std::isfinite(*value)) return say(field, "%g is not a finite number", *value);
+    if (value && !std::isfinite(*value)) return say(field, drivers::printf_text("%g is not a finite number", *value));
   const struct {
     const char* field;
     const std::optional<double>& value;
@@ -50,21 +48,21 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
       {"window_rs_est_ohm", w.rs_est_ohm},           {"window_temp_C", w.temp_C},
   };
   for (const auto& e : estimates)
-    if (e.value && !std::isfinite(*e.value)) return say(e.field, "%g is not a finite number", *e.value);
+    if (e.value && !std::isfinite(*e.value)) return say(e.field, drivers::printf_text("%g is not a finite number", *e.value));
 
   if (w.samples == 0) return std::string("window_samples: 0, a window without samples");
-  if (!(w.window_s > 0)) return say("window_s", "%g s: a window has a length", w.window_s);
+  if (!(w.window_s > 0)) return say("window_s", drivers::printf_text("%g s: a window has a length", w.window_s));
   if (w.im_A < -kMagnitudeTolerance_A)
-    return say("window_im_A", "%g A is negative: it is the mean of a current magnitude", w.im_A);
+    return say("window_im_A", drivers::printf_text("%g A is negative: it is the mean of a current magnitude", w.im_A));
   // The mean of a vector's magnitude is never less than the magnitude of its mean (the
   // triangle inequality): an I_m below hypot(I_d, I_q) was not measured with them.
   const double im_min = std::hypot(w.id_A, w.iq_A) * (1 - 1e-3) - kMagnitudeTolerance_A;
   if (w.im_A < im_min)
-    return say("window_im_A", "%g A is less than the magnitude of the window's mean (I_d, I_q), %g A", w.im_A,
-               std::hypot(w.id_A, w.iq_A));
-  if (w.udc_V < kMinUdc_V) return say("window_udc_V", "%g V is negative: the DC bus never reverses", w.udc_V);
+    return say("window_im_A", drivers::printf_text("%g A is less than the magnitude of the window's mean (I_d, I_q), %g A", w.im_A,
+               std::hypot(w.id_A, w.iq_A)));
+  if (w.udc_V < kMinUdc_V) return say("window_udc_V", drivers::printf_text("%g V is negative: the DC bus never reverses", w.udc_V));
   if (w.temp_C && (*w.temp_C < kMinTemp_C || *w.temp_C > kMaxTemp_C))
-    return say("window_temp_C", "%g degC is outside a winding's [-30, 250] degC", *w.temp_C);
+    return say("window_temp_C", drivers::printf_text("%g degC is outside a winding's [-30, 250] degC", *w.temp_C));
   const struct {
     const char* field;
     double value;
@@ -72,8 +70,8 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
                    {"window_fallback_fraction", w.fallback_fraction},
                    {"window_lock_lost_fraction", w.lock_lost_fraction}};
   for (const auto& f : fractions)
-    if (f.value < -1e-6 || f.value > 1 + 1e-6) return say(f.field, "%g is not a fraction in [0, 1]", f.value);
-  if (meter.gate_s < 0) return say("gate_s", "%g s is negative", meter.gate_s);
+    if (f.value < -1e-6 || f.value > 1 + 1e-6) return say(f.field, drivers::printf_text("%g is not a fraction in [0, 1]", f.value));
+  if (meter.gate_s < 0) return say("gate_s", drivers::printf_text("%g s is negative", meter.gate_s));
   return std::nullopt;
 }
 

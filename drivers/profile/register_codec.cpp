@@ -148,7 +148,7 @@ std::error_code decode_registers(const RegisterEncoding& e, std::span<const std:
 }
 
 std::uint16_t field_max(std::uint16_t mask) {
-  return mask == 0 ? 0 : static_cast<std::uint16_t>(mask >> std::countr_zero(mask));
+  return mask == 0 ? std::uint16_t{0} : static_cast<std::uint16_t>(mask >> std::countr_zero(mask));
 }
 
 std::error_code decode_field(const RegisterEncoding& e, std::uint16_t mask, std::uint16_t word, double& value) {

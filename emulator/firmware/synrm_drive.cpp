@@ -230,7 +230,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       // to drive current through zero volts), then the speed loop resumes on the encoder.
       id_pi_.reset();
       iq_pi_.reset();
-      guard_recovery_steps_ = static_cast<long>(std::lround(kGuardRecovery_s / ts_));
+      guard_recovery_steps_ = std::lround(kGuardRecovery_s / ts_);
     }
     guard_held_ = estimator_->lock_lost();
   }

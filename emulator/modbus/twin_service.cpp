@@ -79,7 +79,7 @@ void TwinService::run(double time_scale) {
         const auto due = static_cast<std::int64_t>(std::floor((target - twin_.time_s()) / step + 1e-9));
         if (due <= 0) break;
         // Behind schedule by more than one wake-up's worth: the CPU did not keep up.
-        if (first) max_lag_s_ = std::max(max_lag_s_, due * step - time_scale * period.count());
+        if (first) max_lag_s_ = std::max(max_lag_s_, static_cast<double>(due) * step - time_scale * period.count());
         first = false;
         signals_.advance(std::min(due, kMaxStepsPerLock));
       }

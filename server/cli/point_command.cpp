@@ -7,6 +7,7 @@
 
 #include "app/bench_backend.hpp"
 #include "app/supervised_point.hpp"
+#include "bench/current_angle.hpp"
 #include "bench/point_procedure.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "drivers/bench_config.hpp"
@@ -111,7 +112,7 @@ int point_command(const std::vector<std::string>& argv) {
     if (req.load_Nm < 0 || req.load_Nm > load_max)
       throw UsageError("--load-Nm", drivers::format_number(req.load_Nm) + " is outside [0, " + drivers::format_number(load_max) +
                                         "] N m (the load drive's current limit)");
-    if (req.angle_deg <= 0 || req.angle_deg >= 90)
+    if (!bench::is_motoring_angle(req.angle_deg))
       throw UsageError("--angle-deg", drivers::format_number(req.angle_deg) + " is outside (0, 90) deg");
     if (req.window_s <= 0 || req.window_s > 3600)
       throw UsageError("--window-s", drivers::format_number(req.window_s) + " is outside (0, 3600] s");

@@ -5,6 +5,8 @@
 
 #include "server/http/response_schemas.hpp"
 
+#include "bench/current_angle.hpp"
+
 #include <chrono>
 #include <memory>
 #include <sstream>
@@ -219,7 +221,7 @@ void add_api_routes(Router& router, ApiContext ctx) {
                         [max_speed_rpm, max_load_Nm](const Request&) {
                           return json_response(200, {{"speed_rpm", {{"min", 0}, {"max", max_speed_rpm}}},
                                                      {"load_Nm", {{"min", 0}, {"max", max_load_Nm}}},
-                                                     {"angle_deg", {{"min_exclusive", 0}, {"max_exclusive", 90}}},
+                                                     {"angle_deg", {{"min_exclusive", bench::kMotoringAngleAbove_deg}, {"max_exclusive", bench::kMotoringAngleBelow_deg}}},
                                                      {"tick_ms", BenchRuntime::kTick.count()}});
                         }},
                        bench_config_schema()));
@@ -301,7 +303,9 @@ void add_api_routes(Router& router, ApiContext ctx) {
                              {"properties",
                               {{"speed_rpm", number_schema(0, max_speed_rpm, "SynRM speed setpoint")},
                                {"load_Nm", number_schema(0, max_load_Nm, "braking torque of the load")},
-                               {"angle_deg", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 90}, {"exclusiveMaximum", true}, {"description", "current angle"}}}}}}});
+                               {"angle_deg", {{"type", "number"}, {"minimum", bench::kMotoringAngleAbove_deg}, {"exclusiveMinimum", true},
+                                              {"maximum", bench::kMotoringAngleBelow_deg}, {"exclusiveMaximum", true},
+                                              {"description", "current angle, motoring"}}}}}}});
 }
 
 }  // namespace synbench::http

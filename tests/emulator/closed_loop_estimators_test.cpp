@@ -410,7 +410,7 @@ namespace {
 // at the lost point's 76 deg, where the shaft makes any angle error grow, and the fresh EEMF-LUT
 // lost the rotor again at the next 40 deg point of every load in the thesis sweep.
 void run_s(emulator::Twin& tw, double s) {
-  tw.run_steps(static_cast<std::int64_t>(std::lround(s / tw.step_s())));
+  tw.run_steps(std::lround(s / tw.step_s()));
 }
 
 // Spun up at 45 deg on `e`, loaded at 2 N m/s as the bench ramps it, then driven to 76 deg, where

@@ -49,7 +49,7 @@ Run run(const Signal& w_of_t, const Signal& offset_of_t, double id, const Signal
   Run out;
   const long n = std::lround(duration_s / kTs), from = std::lround((duration_s - measure_s) / kTs);
   for (long k = 1; k <= n; ++k) {
-    const double t = k * kTs;
+    const double t = static_cast<double>(k) * kTs;
     const double w = w_of_t(t), iq = iq_of_t(t);
     const double psiq = fq.psi(iq), lq = fq.static_inductance_H(iq);
     th += w * kTs;

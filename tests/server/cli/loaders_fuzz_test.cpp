@@ -75,8 +75,8 @@ class Mutator {
 
   std::string mutate(const std::string& seed_text) {
     std::string text = seed_text;
-    const int rounds = 1 + pick(3);
-    for (int i = 0; i < rounds; ++i) text = pick(2) == 0 ? structured(text) : bytes(text);
+    const std::size_t rounds = 1 + pick(3);
+    for (std::size_t i = 0; i < rounds; ++i) text = pick(2) == 0 ? structured(text) : bytes(text);
     return text;
   }
 
