@@ -8,6 +8,7 @@ import {
 } from 'echarts/components';
 import { CanvasRenderer } from 'echarts/renderers';
 import { saveBlob } from './api.js';
+import { exportTitledPng } from './export_png.js';
 
 echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, GridComponent, TooltipComponent, LegendComponent,
   VisualMapComponent, TitleComponent, DataZoomComponent, CanvasRenderer]);
@@ -88,6 +89,7 @@ export class ChartCard {
 
   set(option, { empty = 'no data yet' } = {}) {
     const merged = { ...BASE, ...option };
+    this.option = merged; // for the titled export and the keyboard point reader
     this.ensure().setOption(merged, { notMerge: true, lazyUpdate: true });
     const n = countData(merged);
     this.card.dataset.points = String(n);
@@ -107,6 +109,7 @@ export class ChartCard {
 
   savePng() {
     if (!this.chart) return;
+    if (this.exportMeta && this.option) return exportTitledPng(this); // Results: a titled figure
     const url = this.chart.getDataURL({ type: 'png', pixelRatio: 2, backgroundColor: '#ffffff' });
     fetch(url).then((r) => r.blob()).then((b) => saveBlob(b, `${this.title.replace(/[^A-Za-z0-9]+/g, '-').replace(/^-|-$/g, '').toLowerCase()}.png`));
   }

@@ -4,9 +4,17 @@ import { ChartCard } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
 import { effMapOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
 import { escapeHtml } from './live.js';
+import { ResultTables } from './tables.js';
+import { Compare } from './compare.js';
+import { keyboardPoints } from '../chart_keys.js';
+import { sweepDate } from '../export_png.js';
 
 const $ = (s) => document.querySelector(s);
 const key = (c) => `${c.estimator}/${c.pwm}`;
+// #/results/A/vs/B: the sweep compared with A (main.js's route passes A only)
+const vsFromHash = () => Number(/^#\/results\/\d+\/vs\/(\d+)/.exec(location.hash)?.[1]) || null;
+// file-name part of each card's titled PNG export
+const FIGURE = { map: 'efficiency-map', traj: 'mtpa-me-angle', curve: 'im-pdcm-vs-angle', poserr: 'position-error', delta: 'delta-vs-reference', hist: 'histograms' };
 
 export class ResultsView {
   constructor(app) {
@@ -22,12 +30,21 @@ export class ResultsView {
     this.sweepId = null;
     this.points = [];
     this.analysis = null;
+    for (const [k, c] of Object.entries(this.cards)) {
+      keyboardPoints(c);
+      c.exportMeta = () => this.exportMeta(c, FIGURE[k], k === 'curve' ? 'all-configurations' : k === 'delta' ? `all-vs-${$('#r-ref').value}` : $('#r-config').value,
+        this.sweepName(this.sweepId), (app.sweeps || []).find((s) => s.id === this.sweepId));
+    }
+    this.tables = new ResultTables($('#r-tables'));
+    app.resultsView = this; // window.synbench.resultsView: the end-to-end tests read the charts' options
+    this.compare = new Compare(this, $('#r-compare'));
     app.on('sweeps', (list) => this.fillSweeps(list));
     app.on('view', async ({ view, arg }) => {
       this.visible = view === 'results';
       if (!this.visible) return;
       await app.refreshSweeps();
       if (arg) this.sweepId = arg;
+      this.compare.vsId = arg ? vsFromHash() : null;
       if (!this.sweepId) {
         const done = (app.sweeps || []).filter((s) => s.points_stored > 0);
         this.sweepId = done.length ? done[done.length - 1].id : null;
@@ -35,7 +52,8 @@ export class ResultsView {
       this.fillSweeps(app.sweeps || []);
       if (this.sweepId) this.load();
     });
-    $('#r-sweep').addEventListener('change', () => { this.sweepId = Number($('#r-sweep').value); this.load(); });
+    $('#r-sweep').addEventListener('change', () => { this.sweepId = Number($('#r-sweep').value); this.keepInHash(); this.load(); });
+    $('#r-vs').addEventListener('change', () => { this.compare.vsId = Number($('#r-vs').value) || null; this.keepInHash(); this.compare.load(); });
     $('#r-ref').addEventListener('change', () => this.load());
     for (const id of ['#r-config', '#r-speed', '#r-load']) $(id).addEventListener('change', () => this.draw());
     $('#r-speed').addEventListener('change', () => this.fillLoads());
@@ -50,6 +68,26 @@ export class ResultsView {
     const opts = list.slice().reverse().map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)} (${s.state}, ${s.points_stored} points)</option>`).join('');
     if (sel.innerHTML !== opts) sel.innerHTML = opts || '<option value="">no sweeps yet</option>';
     if (this.sweepId) sel.value = String(this.sweepId);
+    const vs = $('#r-vs');
+    const vopts = '<option value="">no comparison</option>' + list.slice().reverse().filter((s) => s.points_stored > 0)
+      .map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)}</option>`).join('');
+    if (vs.innerHTML !== vopts) vs.innerHTML = vopts;
+    vs.value = String(this.compare.vsId || '');
+  }
+
+  // The URL says what is shown: #/results/A, or #/results/A/vs/B (a reload or a link shows it).
+  keepInHash() {
+    const h = `#/results/${this.sweepId}${this.compare.vsId ? `/vs/${this.compare.vsId}` : ''}`;
+    if (location.hash !== h) history.replaceState(null, '', h);
+  }
+
+  sweepName(id) { return this.compare.sweepName(id); }
+
+  // What a titled PNG export of card says (export_png.js).
+  exportMeta(card, figure, config, sweepText, sweep) {
+    const date = sweepDate(sweep);
+    return { title: card.h.textContent, subtitle: `${sweepText} · configuration ${config.replace('/', ' / ')} · ${date}`,
+      sweepId: this.sweepId, figure, config, date };
   }
 
   refQuery() {
@@ -69,6 +107,7 @@ export class ResultsView {
       this.analysis = analysis;
       this.fillSelectors();
       this.draw();
+      this.compare.load();
       const p = analysis.points || {};
       $('#r-summary').textContent = `Sweep #${id}: ${p.records ?? points.length} points, ${p.used ?? '?'} used`
         + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`;
@@ -130,6 +169,8 @@ export class ResultsView {
     this.cards.delta.set(deltaOption(a), { empty: 'needs a second configuration measured at the reference\'s speeds and loads' });
     this.cards.hist.set(histOption(a, cfg), { empty: estimator === 'encoder' ? 'the encoder estimates nothing: choose an estimator' : 'no estimates in this sweep' });
     this.cards.hist.h.textContent = `Histograms, ${cfgLabel(cfg)} (Figs. 6.16-6.19)`;
+    this.tables.render(a, cfg);
+    this.compare.draw(cfg, speed, load);
   }
 
   async exportAnalysisCsv() {

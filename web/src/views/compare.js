@@ -1,0 +1,141 @@
+// Comparing two runs in the Results view (#/results/A/vs/B): both runs' MTPA/ME trajectories and
+// I_m/P_dcM curves of the chosen configuration on one chart each, labelled "sweep #A ..." and
+// "sweep #B ...", and the difference B - A per configuration x speed x load (MTPA angle, ME angle,
+// η and P_dcM at ME) as a chart and a table; points measured in only one run are listed as such.
+// Both analyses come from GET /api/sweeps/{id}/analysis: the page only subtracts.
+import { api } from '../api.js';
+import { ChartCard, axis, PALETTE } from '../charts.js';
+import { analysisConfigs } from '../analysis_configs.js';
+import { trajectoriesOption, curveOption, cfgLabel } from './plots.js';
+import { tableBlock, numCell, textCell } from './tables.js';
+import { keyboardPoints } from '../chart_keys.js';
+
+const ckey = (c) => `${c.estimator}/${c.pwm}`;
+const pkey = (c) => `${ckey(c)}|${c.speed_rpm}|${c.load_Nm}`;
+const sub = (b, a) => (a == null || b == null || !Number.isFinite(a) || !Number.isFinite(b) ? null : b - a);
+const r4 = (v) => (v == null ? null : Number(v.toFixed(4)));
+
+// Every (configuration, speed, load) curve of a and b: the differences b - a where both have it,
+// else the run that has it. Sorted by configuration (thesis order), speed, load.
+export function diffRuns(a, b) {
+  const ea = new Map((a?.curves?.entries || []).map((e) => [pkey(e), e]));
+  const eb = new Map((b?.curves?.entries || []).map((e) => [pkey(e), e]));
+  const order = analysisConfigs({ curves: { entries: [...ea.values(), ...eb.values()] } }).map(ckey);
+  const rows = [];
+  for (const k of new Set([...ea.keys(), ...eb.keys()])) {
+    const x = ea.get(k);
+    const y = eb.get(k);
+    const e = x || y;
+    const row = { estimator: e.estimator, pwm: e.pwm, speed_rpm: e.speed_rpm, load_Nm: e.load_Nm, in: x && y ? 'both' : x ? 'a' : 'b' };
+    if (x && y) {
+      row.mtpa_angle_deg = sub(y.mtpa?.angle_deg, x.mtpa?.angle_deg);
+      row.me_angle_deg = sub(y.me?.angle_deg, x.me?.angle_deg);
+      const eff = sub(y.me?.efficiency, x.me?.efficiency);
+      row.me_efficiency_pp = eff == null ? null : eff * 100;
+      row.me_pdcm_W = sub(y.me?.pdcm_W, x.me?.pdcm_W);
+    }
+    rows.push(row);
+  }
+  return rows.sort((p, q) => order.indexOf(ckey(p)) - order.indexOf(ckey(q)) || p.speed_rpm - q.speed_rpm || p.load_Nm - q.load_Nm);
+}
+
+// The difference chart of one configuration: three panels over (speed, load).
+function diffOption(rows, cfg, ida, idb) {
+  const rs = rows.filter((r) => r.in === 'both' && ckey(r) === ckey(cfg));
+  const cats = rs.map((r) => `${r.speed_rpm} rpm\n${r.load_Nm} N m`);
+  const bar = (name, f, k, color) => ({ name, type: 'bar', xAxisIndex: k, yAxisIndex: k, color, data: rs.map((r) => r4(r[f])) });
+  const grid = [0, 1, 2].map((k) => ({ left: 64, right: 16, top: `${12 + k * 29}%`, height: '20%' }));
+  return {
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    title: { text: `#${idb} − #${ida}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
+    tooltip: { trigger: 'axis' },
+    grid,
+    xAxis: [0, 1, 2].map((k) => ({ type: 'category', data: cats, gridIndex: k, axisLabel: { show: k === 2, color: '#333b47', fontSize: 10 } })),
+    yAxis: [axis('Δ angle [deg]', { gridIndex: 0, nameGap: 44, scale: false }), axis('Δη at ME [pp]', { gridIndex: 1, nameGap: 44, scale: false }),
+      axis('ΔP_dcM at ME [W]', { gridIndex: 2, nameGap: 44, scale: false })],
+    series: [bar('Δ MTPA angle', 'mtpa_angle_deg', 0, PALETTE[0]), bar('Δ ME angle', 'me_angle_deg', 0, PALETTE[1]),
+      bar('Δη at ME', 'me_efficiency_pp', 1, PALETTE[2]), bar('ΔP_dcM at ME', 'me_pdcm_W', 2, PALETTE[3])],
+  };
+}
+
+// Series of two runs' options on one chart: names prefixed with the run, colours told apart.
+function overlay(oa, ob, ida, idb, label) {
+  const tag = (o, id, run) => o.series.map((s, k) => ({ ...s, name: `sweep #${id} ${label} · ${s.name}`, color: PALETTE[(2 * Math.floor(k / 2) + run) % PALETTE.length] }));
+  return { ...oa, series: [...tag(oa, ida, 0), ...tag(ob, idb, 1)] };
+}
+
+export class Compare {
+  // results: the ResultsView (its sweepId, points, analysis, app)
+  constructor(results, panel) {
+    this.r = results;
+    this.panel = panel;
+    this.vsId = null;
+    this.b = null; // {id, points, analysis}
+    panel.innerHTML = `<h2 id="h-compare">Comparison</h2><p class="muted" id="r-cmp-note"></p>
+      <div class="results-grid"><div class="chart-card" data-chart="r-cmp-traj"></div><div class="chart-card" data-chart="r-cmp-curve"></div>
+      <div class="chart-card" data-chart="r-cmp-diff"></div></div>`;
+    const card = (name, title) => { const c = new ChartCard(panel.querySelector(`[data-chart="${name}"]`), { title }); keyboardPoints(c); return c; };
+    this.cards = { traj: card('r-cmp-traj', 'MTPA and ME angle against load, two runs'),
+      curve: card('r-cmp-curve', 'I_m and P_dcM against angle, two runs'), diff: card('r-cmp-diff', 'Difference of the two runs') };
+    this.table = tableBlock(panel, 'r-cmp-table', 'Difference per configuration, speed and load');
+  }
+
+  // Loads the second run when it changed, then draws; hides the panel without one.
+  async load() {
+    const id = this.vsId;
+    if (!id || !this.r.sweepId) { this.b = null; this.panel.hidden = true; return; }
+    if (this.b?.id !== id) {
+      try {
+        const [points, analysis] = await Promise.all([api('GET', `/api/sweeps/${id}/points`), api('GET', `/api/sweeps/${id}/analysis`)]);
+        if (id !== this.vsId) return;
+        this.b = { id, points, analysis };
+      } catch (e) {
+        this.b = null;
+        this.panel.hidden = false;
+        this.panel.querySelector('#r-cmp-note').textContent = `cannot load sweep ${id}: ${e.message}`;
+        return;
+      }
+    }
+    this.r.draw();
+  }
+
+  sweepName(id) {
+    const s = (this.r.app.sweeps || []).find((x) => x.id === id);
+    return s ? `sweep #${id} “${s.name}”` : `sweep #${id}`;
+  }
+
+  draw(cfg, speed, load) {
+    if (!this.vsId) { this.panel.hidden = true; return; }
+    if (this.b?.id !== this.vsId || !this.r.analysis) return; // still loading, or the load failed (its note stays)
+    this.panel.hidden = false;
+    const ida = this.r.sweepId;
+    const idb = this.b.id;
+    const a = this.r.analysis;
+    const b = this.b.analysis;
+    const label = cfgLabel(cfg);
+    const inB = analysisConfigs(b).some((c) => ckey(c) === ckey(cfg));
+    this.panel.querySelector('#h-compare').textContent = `Comparison: ${this.sweepName(ida)} vs ${this.sweepName(idb)}`;
+    this.panel.querySelector('#r-cmp-note').textContent = inB ? `Differences are #${idb} − #${ida}; the charts show ${label}.`
+      : `${this.sweepName(idb)} has no ${label}: only its other configurations are in the table.`;
+    this.cards.traj.set(overlay(trajectoriesOption(a, cfg), inB ? trajectoriesOption(b, cfg) : { series: [] }, ida, idb, label));
+    this.cards.traj.h.textContent = `MTPA (solid) and ME (dashed) angle against load, ${label}: #${ida} and #${idb}`;
+    this.cards.curve.set(overlay(curveOption(this.r.points, a, speed, load, [cfg]), curveOption(this.b.points, b, speed, load, [cfg]), ida, idb, label),
+      { empty: `no curve at ${speed} rpm, ${load} N m` });
+    this.cards.curve.h.textContent = `I_m and P_dcM against angle at ${speed} rpm, ${load} N m, ${label}: #${ida} and #${idb}`;
+    const rows = diffRuns(a, b);
+    this.cards.diff.set(diffOption(rows, cfg, ida, idb), { empty: 'no (speed, load) measured in both runs' });
+    this.cards.diff.h.textContent = `Difference #${idb} − #${ida} per speed and load, ${label}`;
+    const where = { a: `only in #${ida}`, b: `only in #${idb}`, both: 'both' };
+    this.table.set({
+      head: ['configuration', 'speed [rpm]', 'load [N m]', 'measured', 'Δ MTPA angle [deg]', 'Δ ME angle [deg]', 'Δη at ME [pp]', 'ΔP_dcM at ME [W]'],
+      rowHead: 3,
+      rows: rows.map((r) => [textCell(cfgLabel(r)), numCell(r.speed_rpm, 0), numCell(r.load_Nm, 2), textCell(where[r.in]),
+        numCell(r.mtpa_angle_deg, 2), numCell(r.me_angle_deg, 2), numCell(r.me_efficiency_pp, 2), numCell(r.me_pdcm_W, 2)]),
+    }, `Difference #${idb} − #${ida} per configuration, speed and load`);
+    const date = (id) => (this.r.app.sweeps || []).find((x) => x.id === id);
+    for (const [k, figure] of [['traj', 'mtpa-me-angle'], ['curve', 'im-pdcm-vs-angle'], ['diff', 'difference']]) {
+      this.cards[k].exportMeta = () => this.r.exportMeta(this.cards[k], `${figure}-vs-${idb}`, ckey(cfg),
+        `${this.sweepName(ida)} vs ${this.sweepName(idb)}`, date(ida));
+    }
+  }
+}
