@@ -44,15 +44,18 @@ function diffOption(rows, cfg, ida, idb) {
   const rs = rows.filter((r) => r.in === 'both' && ckey(r) === ckey(cfg));
   const cats = rs.map((r) => `${r.speed_rpm} rpm\n${r.load_Nm} N m`);
   const bar = (name, f, k, color) => ({ name, type: 'bar', xAxisIndex: k, yAxisIndex: k, color, data: rs.map((r) => r4(r[f])) });
-  const grid = [0, 1, 2].map((k) => ({ left: 64, right: 16, top: `${12 + k * 29}%`, height: '20%' }));
+  const grid = [0, 1, 2].map((k) => ({ left: 64, right: 16, top: `${14 + k * 28}%`, height: '18%' }));
+  // panel names above each panel: rotated axis names do not fit three panels
+  const panelTitle = (text, k) => ({ text, left: 64, top: `${8 + k * 28}%`, textStyle: { fontSize: 11, fontWeight: 600, color: '#333b47' } });
   return {
     legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
-    title: { text: `#${idb} − #${ida}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
+    title: [{ text: `#${idb} − #${ida}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
+      panelTitle('Δ MTPA and Δ ME angle [deg]', 0), panelTitle('Δη at ME [percentage points]', 1), panelTitle('ΔP_dcM at ME [W]', 2)],
     tooltip: { trigger: 'axis' },
     grid,
     xAxis: [0, 1, 2].map((k) => ({ type: 'category', data: cats, gridIndex: k, axisLabel: { show: k === 2, color: '#333b47', fontSize: 10 } })),
-    yAxis: [axis('Δ angle [deg]', { gridIndex: 0, nameGap: 44, scale: false }), axis('Δη at ME [pp]', { gridIndex: 1, nameGap: 44, scale: false }),
-      axis('ΔP_dcM at ME [W]', { gridIndex: 2, nameGap: 44, scale: false })],
+    yAxis: [axis('Δ angle [deg]', { gridIndex: 0, scale: false, nameTextStyle: { color: 'rgba(0,0,0,0)' } }), axis('Δη at ME [pp]', { gridIndex: 1, scale: false, nameTextStyle: { color: 'rgba(0,0,0,0)' } }),
+      axis('ΔP_dcM at ME [W]', { gridIndex: 2, scale: false, nameTextStyle: { color: 'rgba(0,0,0,0)' } })],
     series: [bar('Δ MTPA angle', 'mtpa_angle_deg', 0, PALETTE[0]), bar('Δ ME angle', 'me_angle_deg', 0, PALETTE[1]),
       bar('Δη at ME', 'me_efficiency_pp', 1, PALETTE[2]), bar('ΔP_dcM at ME', 'me_pdcm_W', 2, PALETTE[3])],
   };
@@ -60,7 +63,7 @@ function diffOption(rows, cfg, ida, idb) {
 
 // Series of two runs' options on one chart: names prefixed with the run, colours told apart.
 function overlay(oa, ob, ida, idb, label) {
-  const tag = (o, id, run) => o.series.map((s, k) => ({ ...s, name: `sweep #${id} ${label} · ${s.name}`, color: PALETTE[(2 * Math.floor(k / 2) + run) % PALETTE.length] }));
+  const tag = (o, id, run) => o.series.map((s, k) => ({ ...s, name: `sweep #${id} ${label} · ${s.name.replace(` ${label}`, '')}`, color: PALETTE[(2 * Math.floor(k / 2) + run) % PALETTE.length] }));
   return { ...oa, series: [...tag(oa, ida, 0), ...tag(ob, idb, 1)] };
 }
 
@@ -73,7 +76,7 @@ export class Compare {
     this.b = null; // {id, points, analysis}
     panel.innerHTML = `<h2 id="h-compare">Comparison</h2><p class="muted" id="r-cmp-note"></p>
       <div class="results-grid"><div class="chart-card" data-chart="r-cmp-traj"></div><div class="chart-card" data-chart="r-cmp-curve"></div>
-      <div class="chart-card" data-chart="r-cmp-diff"></div></div>`;
+      <div class="chart-card wide" data-chart="r-cmp-diff"></div></div>`;
     const card = (name, title) => { const c = new ChartCard(panel.querySelector(`[data-chart="${name}"]`), { title }); keyboardPoints(c); return c; };
     this.cards = { traj: card('r-cmp-traj', 'MTPA and ME angle against load, two runs'),
       curve: card('r-cmp-curve', 'I_m and P_dcM against angle, two runs'), diff: card('r-cmp-diff', 'Difference of the two runs') };
