@@ -61,5 +61,5 @@ export function keyboardPoints(card) {
     card.chart.dispatchAction({ type: 'showTip', seriesIndex: si, dataIndex: di });
     out.textContent = describePoint(card.option, si, di);
   });
-  el.addEventListener('blur', () => card.chart?.dispatchAction({ type: 'hideTip' }));
+  el.addEventListener('blur', () => { card.chart?.dispatchAction({ type: 'hideTip' }); card.chart?.dispatchAction({ type: 'downplay' }); });
 }
