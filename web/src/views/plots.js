@@ -3,7 +3,7 @@
 import { axis, PALETTE } from '../charts.js';
 
 const r2 = (v, d = 2) => (v == null || !Number.isFinite(v) ? null : Number(v.toFixed(d)));
-const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
+export const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
 export const cfgLabel = (c) => `${c.estimator} / ${c.pwm}`;
 
 // Efficiency map (P_m / P_dcM at the ME angle) over load x speed, as a heat map with values.

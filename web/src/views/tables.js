@@ -4,7 +4,7 @@
 // fixed precision; the CSV carries them unrounded.
 import { saveBlob } from '../api.js';
 import { analysisConfigs } from '../analysis_configs.js';
-import { cfgLabel } from './plots.js';
+import { cfgLabel, sameCfg } from './plots.js';
 import { escapeHtml } from './live.js';
 
 // A cell: {v: the value for the CSV, t: the text shown}.
@@ -13,7 +13,6 @@ export const numCell = (v, d) => ({ v: v == null || !Number.isFinite(v) ? '' : v
 export const textCell = (s) => ({ v: s, t: s });
 const pct = (v) => (v == null ? null : v * 100);
 const note = (o) => (o ? [o.at_edge ? 'at edge' : '', o.refined ? 'refined' : ''].filter(Boolean).join(', ') : '');
-const sameCfg = (a, b) => a.estimator === b.estimator && a.pwm === b.pwm;
 
 const csvField = (v) => (/[",\n]/.test(String(v)) ? `"${String(v).replace(/"/g, '""')}"` : String(v));
 export function tableCsv(model) {
