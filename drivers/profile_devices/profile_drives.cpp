@@ -63,6 +63,29 @@ void keep_by_host(W& w, const HostWindow& h) {
   w.host = {h.period_s(), h.longest_gap_s()};
 }
 
+// A window's result from the means the host kept over `polled` (its span into `span`), or
+// else from the device's own window registers: the choice every profile device but the
+// SynRM drive (which has more to read) makes the same way.
+template <class W, std::size_t NM, std::size_t NR>
+std::error_code read_window_result(W& out, const HostWindow* host, double W::*span,
+                                   const SignalField<W> (&means)[NM], const ReadPlan& polled,
+                                   const SignalField<W> (&registers)[NR], const ReadPlan& plan,
+                                   WindowChannel& channel) {
+  W w;
+  if (host) {
+    if (auto ec = host->result()) return ec;
+    keep_by_host(w, *host);
+    w.*span = host->span_s();
+    assign_means(w, means, polled, *host);
+  } else {
+    std::vector<double> v(plan.size());
+    if (auto ec = channel.read_results(plan, v)) return ec;
+    assign_read(w, registers, plan, v);
+  }
+  out = w;
+  return {};
+}
+
 // The device's own code behind a fault the profile has no label for.
 std::optional<std::int64_t> raw_code(Fault f, double device_value) {
   if (f != Fault::unknown || std::isnan(device_value)) return std::nullopt;
@@ -241,19 +264,8 @@ std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
 }
 
 std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
-  LoadWindow w;
-  if (host_) {
-    if (auto ec = host_->result()) return ec;
-    keep_by_host(w, *host_);
-    w.window_s = host_->span_s();
-    assign_means(w, kLoadHostMeans, telemetry_, *host_);
-  } else {
-    std::vector<double> v(window_.size());
-    if (auto ec = window().read_results(window_, v)) return ec;
-    assign_read(w, kLoadWindowSignals, window_, v);
-  }
-  out = w;
-  return {};
+  return read_window_result(out, host_, &LoadWindow::window_s, kLoadHostMeans, telemetry_, kLoadWindowSignals,
+                            window_, window());
 }
 
 // --- VFC meter -----------------------------------------------------------------------------
@@ -276,19 +288,8 @@ ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
 
 std::error_code ProfileMeter::read(MeterReading& out) {
   if (totalizer_) return totalizer_->read(out);
-  MeterReading m;
-  if (host_) {
-    if (auto ec = host_->result()) return ec;
-    keep_by_host(m, *host_);
-    m.gate_s = host_->span_s();
-    assign_means(m, kMeterPowerMeans, power_, *host_);
-  } else {
-    std::vector<double> v(gate_.size());
-    if (auto ec = window().read_results(gate_, v)) return ec;
-    assign_read(m, kMeterGateSignals, gate_, v);
-  }
-  out = m;
-  return {};
+  return read_window_result(out, host_, &MeterReading::gate_s, kMeterPowerMeans, power_, kMeterGateSignals, gate_,
+                            window());
 }
 
 }  // namespace synbench::drivers

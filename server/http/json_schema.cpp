@@ -5,6 +5,7 @@
 #include <set>
 
 #include "drivers/json.hpp"
+#include "drivers/json_reader.hpp"
 #include "drivers/profile/number_format.hpp"
 
 namespace synbench::http {
@@ -19,21 +20,11 @@ std::string to_string(const std::vector<SchemaError>& errors) {
   return out;
 }
 
-std::string pointer_token(const std::string& token) {
-  std::string out;
-  for (const char c : token) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
-
 namespace {
 
 using Errors = std::vector<SchemaError>;
 
-std::string member(const std::string& ptr, const std::string& key) { return ptr + "/" + pointer_token(key); }
+std::string member(const std::string& ptr, const std::string& key) { return ptr + "/" + drivers::json_pointer_token(key); }
 
 bool is_type(const synbench::Json& v, const std::string& type) {
   if (type == "object") return v.is_object();

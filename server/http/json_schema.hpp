@@ -34,7 +34,4 @@ std::vector<SchemaError> validate(const synbench::Json& schema, const synbench::
 // does not implement, or a keyword's value of the wrong kind.
 std::vector<SchemaError> check_schema(const synbench::Json& schema);
 
-// `token` escaped for a JSON pointer: '~' as "~0", '/' as "~1".
-std::string pointer_token(const std::string& token);
-
 }  // namespace synbench::http

@@ -14,16 +14,13 @@
 
 #include "drivers/json.hpp"
 #include "drivers/profile/device_profile.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 namespace synbench::drivers {
 namespace {
 
 using json = synbench::Json;
 
-json doc_of(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return json::parse(in);
-}
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;
@@ -109,7 +106,7 @@ TEST(DeviceSignals, EachTableMapsSignalsAndMembersOneToOne) {
 // window signal is. (Without any window signal the same profile is a host-kept window.)
 TEST(DeviceSignals, TheWindowSchemaTakesADrivesWindowTableSignalsAsWindowSignals) {
   const auto without_window = [](DeviceKind kind, std::string_view keep) {
-    json doc = doc_of(default_profile_path(kind));
+    json doc = testing::json_doc(default_profile_path(kind));
     json& map = doc["signals"];
     std::vector<std::string> drop;
     for (const auto& [name, _] : map.items())
@@ -139,7 +136,7 @@ TEST(DeviceSignals, TheWindowSchemaRequiresAMeterTablesSignalsForItsMeterKind) {
   const auto check = [](const std::filesystem::path& profile, const std::vector<std::string_view>& signals,
                         const std::string& meter) {
     for (const std::string_view s : signals) {
-      json doc = doc_of(profile);
+      json doc = testing::json_doc(profile);
       doc["signals"].erase(std::string(s));
       const ProfileParseResult r = parse_device_profile(doc);
       ASSERT_EQ(r.errors.size(), 1u) << s << describe(r.errors);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include "drivers/json.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 #include <fstream>
 #include <string>
@@ -13,12 +14,8 @@ namespace {
 
 using json = synbench::Json;
 
-json doc_of(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return json::parse(in);
-}
-json default_doc(DeviceKind kind) { return doc_of(default_profile_path(kind)); }
-json test_doc(const char* file) { return doc_of(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / file); }
+json default_doc(DeviceKind kind) { return testing::json_doc(default_profile_path(kind)); }
+json test_doc(const char* file) { return testing::json_doc(std::filesystem::path(SYNBENCH_TEST_PROFILE_DIR) / file); }
 
 std::string describe(const std::vector<ProfileError>& errors) {
   std::string s;

@@ -11,15 +11,9 @@
 #include "emulator/modbus/tcp_server.hpp"
 #include "emulator/modbus/twin_service.hpp"
 #include "tests/drivers/bus/socat_pair.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 namespace synbench::testing {
-
-inline std::vector<drivers::DeviceProfile> default_profiles() {
-  std::vector<drivers::DeviceProfile> out;
-  for (auto k : drivers::kDeviceKinds)
-    out.push_back(*drivers::load_device_profile(drivers::default_profile_path(k)).profile);
-  return out;
-}
 
 struct Emulator {
   explicit Emulator(const emulator::FaultPlan& plan = {}, double time_scale = 1.0)

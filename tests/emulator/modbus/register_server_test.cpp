@@ -9,17 +9,14 @@
 #include "drivers/profile/device_profile.hpp"
 #include "emulator/modbus/modbus_pdu.hpp"
 #include "emulator/modbus/register_server.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 namespace synbench::emulator {
 namespace {
 
 using namespace modbus;
 
-std::vector<drivers::DeviceProfile> default_profiles() {
-  std::vector<drivers::DeviceProfile> out;
-  for (auto k : drivers::kDeviceKinds) out.push_back(*drivers::load_device_profile(drivers::default_profile_path(k)).profile);
-  return out;
-}
+using testing::default_profiles;
 
 class RecordingProvider final : public SignalProvider {
  public:

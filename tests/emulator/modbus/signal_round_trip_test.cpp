@@ -15,6 +15,7 @@
 #include "drivers/profile_devices/profile_bench.hpp"
 #include "emulator/modbus/twin_register_bus.hpp"
 #include "emulator/modbus/twin_service.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 namespace synbench::emulator {
 namespace {
@@ -23,11 +24,7 @@ using drivers::DeviceKind;
 using drivers::DriveState;
 using drivers::Fault;
 
-std::vector<drivers::DeviceProfile> default_profiles() {
-  std::vector<drivers::DeviceProfile> out;
-  for (auto k : drivers::kDeviceKinds) out.push_back(*drivers::load_device_profile(drivers::default_profile_path(k)).profile);
-  return out;
-}
+using testing::default_profiles;
 
 // What a register can carry back of `v`: half a step of an integer register, a float's precision.
 double tolerance(const drivers::ProfileSignal& s, double v) {

@@ -11,6 +11,7 @@
 #include "emulator/modbus/modbus_pdu.hpp"
 #include "emulator/modbus/twin_register_bus.hpp"
 #include "emulator/modbus/twin_service.hpp"
+#include "tests/drivers/default_profiles.hpp"
 
 namespace synbench::emulator {
 namespace {
@@ -19,11 +20,7 @@ using drivers::DeviceKind;
 using drivers::DriveState;
 using drivers::Fault;
 
-std::vector<drivers::DeviceProfile> default_profiles() {
-  std::vector<drivers::DeviceProfile> out;
-  for (auto k : drivers::kDeviceKinds) out.push_back(*drivers::load_device_profile(drivers::default_profile_path(k)).profile);
-  return out;
-}
+using testing::default_profiles;
 
 struct TwinFixture : ::testing::Test {
   std::vector<drivers::DeviceProfile> profiles = default_profiles();
