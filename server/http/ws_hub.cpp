@@ -136,7 +136,7 @@ void WsHub::on_tick() {
   }
   last_event_seq_ = max_seq;
   // A state message whenever what GET /api/bench/status shows changes, telemetry aside: enable,
-  // stop, phase, trip, setpoints, mode, sweep state, a new event. So a page need not poll.
+  // stop, phase, trip, setpoints, mode, sweep state or point, a new event. So a page need not poll.
   const std::string state_key =
       std::to_string(s.enabled) + std::to_string(s.stopping) + phase_name(s.phase) + std::to_string(s.trip.has_value()) +
       std::to_string(s.alarm.has_value()) + std::to_string(s.heartbeats) +
