@@ -16,6 +16,30 @@ Refusal device_error(const std::string& what, std::error_code ec) {
   return {Refused::device_error, what + ": " + ec.message()};
 }
 
+// The status as one sample of the telemetry history.
+TelemetrySample history_sample(const BenchStatus& s) {
+  TelemetrySample h;
+  const auto f = [](double v) { return static_cast<float>(v); };
+  h.t_s = s.t_s;
+  if (s.synrm) {
+    const auto& t = *s.synrm;
+    h.speed_rpm = f(t.speed_rpm);
+    h.im_A = f(t.im_A);
+    h.id_A = f(t.id_A);
+    h.iq_A = f(t.iq_A);
+    h.udc_V = f(t.udc_V);
+    h.pac_W = f(t.pac_W);
+    if (t.temp_C) h.temp_C = f(*t.temp_C);
+    if (t.pos_err_deg) h.pos_err_deg = f(*t.pos_err_deg);
+  }
+  if (s.load) h.torque_Nm = f(s.load->torque_Nm);
+  h.cmd_speed_rpm = f(s.commanded.speed_rpm);
+  h.cmd_load_Nm = f(s.commanded.load_Nm);
+  h.cmd_angle_deg = f(s.commanded.angle_deg);
+  h.enabled = (s.enabled || (s.sweep && s.sweep->current_index)) ? 1.0f : 0.0f;
+  return h;
+}
+
 }  // namespace
 
 BenchRuntime::BenchRuntime(std::unique_ptr<BenchBackend> backend, Serializer serializer, EventLog log)
@@ -24,8 +48,9 @@ BenchRuntime::BenchRuntime(std::unique_ptr<BenchBackend> backend, Serializer ser
       devices_(backend_->describe()),
       serializer_(std::move(serializer)),
       log_(std::move(log)) {
+  commanded_ = std::make_unique<CommandedDevices>(backend_->devices());
   supervisor_ = std::make_unique<bench::SafetySupervisor>(
-      backend_->devices(), description_.limits,
+      commanded_->devices(), description_.limits,
       [this](const std::string& kind, const std::string& message) { event(kind, message); });
   publish();
 }
@@ -216,17 +241,20 @@ void BenchRuntime::publish() {
   s.trip = supervisor_->trip();
   s.alarm = supervisor_->alarm();
   s.disable = supervisor_->disable_report();
+  const Commanded& c = commanded_->commanded();
+  s.commanded = {c.speed_rpm.value_or(0.0), c.load_Nm.value_or(0.0), c.angle_deg.value_or(setpoints_.angle_deg)};
   s.ticks = ticks_;
   s.overruns = overruns_;
   s.events = events_;
   if (sweep_) {
     const auto p = sweep_->engine().progress();
     s.sweep = SweepInfo{sweep_->id(), std::string(bench::name(sweep_->engine().state())), p.done, p.total,
-                        sweep_->engine().error()};
+                        sweep_->engine().error(), p.current_index, sweep_->engine().current_request()};
   } else {
     s.sweep = last_sweep_;
   }
   if (serializer_) snap->text = serializer_(s);
+  history_.offer(history_sample(s));
   std::lock_guard lock(snapshot_mutex_);
   snapshot_ = std::move(snap);
 }
@@ -245,7 +273,7 @@ std::optional<Refusal> BenchRuntime::busy_with_sweep() const {
 }
 
 std::optional<Refusal> BenchRuntime::apply_setpoints() {
-  auto dev = backend_->devices();
+  auto dev = commanded_->devices();
   std::error_code ec;
   if ((ec = dev.synrm->set_angle_deg(setpoints_.angle_deg)) || (ec = dev.synrm->set_speed_rpm(setpoints_.speed_rpm)) ||
       (ec = dev.load->set_torque_Nm(setpoints_.load_Nm)))
@@ -261,7 +289,7 @@ std::optional<Refusal> BenchRuntime::begin_disable(double now_s) {
   bench::OrderedStopOptions opt;
   opt.load_ramp_Nm_per_s = bench::kBenchLoadRamp_Nm_per_s;
   const auto& lt = supervisor_->load();
-  stop_.begin(backend_->devices(), opt, now_s, lt ? lt->torque_Nm : setpoints_.load_Nm);
+  stop_.begin(commanded_->devices(), opt, now_s, lt ? lt->torque_Nm : setpoints_.load_Nm);
   event("stop", "ordered stop requested");
   return std::nullopt;
 }
@@ -277,7 +305,7 @@ void BenchRuntime::enable(bool on, Done done) {
           return Refusal{Refused::drive_running, "alarm: " + supervisor_->alarm()->detail + "; reset first"};
         if (enabled_ && !stop_.active()) return std::nullopt;
         stop_.cancel();
-        auto dev = backend_->devices();
+        auto dev = commanded_->devices();
         std::error_code ec;
         if ((ec = dev.synrm->set_estimator(mode_.estimator)) || (ec = dev.synrm->set_pwm(mode_.pwm)))
           return device_error("setting the drive mode", ec);
@@ -377,7 +405,7 @@ void BenchRuntime::start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<
         sweep_store_ = std::make_unique<db::Store>(std::move(*opened));
         SweepRunOptions options;
         options.calibration.load_b1_Nms_per_rad = description_.load_b1_Nms_per_rad;
-        sweep_ = std::make_unique<SweepRun>(backend_->devices(), *supervisor_, *sweep_store_, id, std::move(shared->first),
+        sweep_ = std::make_unique<SweepRun>(commanded_->devices(), *supervisor_, *sweep_store_, id, std::move(shared->first),
                                             std::move(shared->second), options);
         if (auto e = sweep_->begin()) {
           sweep_.reset();
@@ -409,7 +437,7 @@ void BenchRuntime::finish_sweep(double now_s) {
   const auto state = sweep_->engine().state();
   const std::string& error = sweep_->engine().error();
   const std::string which = "sweep " + std::to_string(sweep_->id());
-  last_sweep_ = SweepInfo{sweep_->id(), std::string(bench::name(state)), p.done, p.total, error};
+  last_sweep_ = SweepInfo{sweep_->id(), std::string(bench::name(state)), p.done, p.total, error, std::nullopt, std::nullopt};
   // A sweep's store failure (a lost file, a full disk) is a fault an operator must see in the
   // journal, with the store's message, as the supervisor's trips.
   if (auto e = sweep_->finish()) event("fault", which + ": recording its final state failed: " + *e);

@@ -27,7 +27,9 @@
 
 #include "app/bench_backend.hpp"
 #include "app/bench_status.hpp"
+#include "app/commanded_devices.hpp"
 #include "app/refusal.hpp"
+#include "app/telemetry_history.hpp"
 #include "app/sweep_run.hpp"
 #include "bench/ordered_stop.hpp"
 #include "bench/safety_supervisor.hpp"
@@ -75,6 +77,9 @@ class BenchRuntime {
   std::shared_ptr<const StatusSnapshot> snapshot() const;
   const BenchDescription& description() const { return description_; }
   const synbench::Json& devices_json() const { return devices_; }
+  // The telemetry of the last 15 min, a sample per 50 ms of bench time (offered every tick).
+  TelemetryHistory& history() { return history_; }
+  const TelemetryHistory& history() const { return history_; }
 
   // Commands. `done` is called on the bench thread once the command was acted on or refused.
   // Enabling starts both drives with the current setpoints; disabling is the ordered stop.
@@ -127,6 +132,8 @@ class BenchRuntime {
 
   std::unique_ptr<BenchBackend> backend_;
   const BenchDescription description_;
+  // The backend's devices as every command here reaches them: what was last written is recorded.
+  std::unique_ptr<CommandedDevices> commanded_;
   const synbench::Json devices_;
   Serializer serializer_;
   EventLog log_;
@@ -140,6 +147,7 @@ class BenchRuntime {
   bool closed_ = false;    // the bench thread has ended: everything is refused
   mutable std::mutex snapshot_mutex_;
   std::shared_ptr<const StatusSnapshot> snapshot_;
+  TelemetryHistory history_;
 
   // The bench thread's own state: nobody else reads or writes it.
   std::unique_ptr<bench::SafetySupervisor> supervisor_;

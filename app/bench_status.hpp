@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "bench/point_procedure.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "drivers/devices.hpp"
 
@@ -47,6 +48,8 @@ struct SweepInfo {
   std::string state;  // bench::SweepState's name
   std::size_t done = 0, total = 0;
   std::string error;
+  std::optional<std::size_t> current_index;     // the point being measured, while running
+  std::optional<bench::PointRequest> point;     // its request (speed, load, angle, configuration)
 };
 
 struct BenchStatus {
@@ -54,7 +57,10 @@ struct BenchStatus {
   bool enabled = false;
   bool stopping = false;  // an ordered stop asked for by disable or shutdown is under way
   bool heartbeats = true;  // false from an E-stop to the reset: the drives' watchdogs are armed
-  Setpoints setpoints;
+  Setpoints setpoints;  // the manual setpoints (kept for the next enable)
+  // What the bench writes to the drives now, whoever writes it (manual operation, a sweep's point
+  // with its load ramp, a stop): the last speed, load torque and angle each drive accepted.
+  Setpoints commanded;
   DriveMode mode;
   std::optional<drivers::SynrmTelemetry> synrm;
   std::optional<drivers::LoadTelemetry> load;

@@ -73,6 +73,10 @@ class SweepEngine {
   bool finished() const;
   const std::string& error() const { return error_; }
   SweepProgress progress() const;
+  // The request of the point under way (empty between points and once stopping).
+  std::optional<PointRequest> current_request() const {
+    return current_ ? std::optional<PointRequest>(current_->point.request) : std::nullopt;
+  }
 
  private:
   struct Next {

@@ -7,6 +7,8 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <chrono>
 #include <functional>
 #include <thread>
 #include <cstdlib>
@@ -28,6 +30,7 @@
 #include "server/http/http_server.hpp"
 #include "server/http/router.hpp"
 #include "server/http/sweep_routes.hpp"
+#include "server/http/telemetry_routes.hpp"
 #include "server/http/tokens.hpp"
 #include "server/http/worker.hpp"
 #include "server/http/ws_hub.hpp"
@@ -173,6 +176,19 @@ int serve_command(const std::vector<std::string>& argv) {
   // the E-stop.
   http::Worker worker;
   http::add_sweep_routes(router, *store, bench, control, worker, data_dir / "synbench.db", bench_meta);
+  // The telemetry trace of the last run, before this one's with the down time as a gap; saved
+  // every 30 s on the worker (atomically) and at the end, so a restart keeps it.
+  const auto history_file = data_dir / "telemetry-history.bin";
+  const auto wall_s = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  if (auto e = bench.history().load(history_file, bench.snapshot()->status.t_s, wall_s()))
+    std::cerr << "synbench serve: " << history_file.string() << " is unreadable (" << e.message() << "): the trace starts anew\n";
+  const auto save_history = [&bench, history_file, wall_s] {
+    if (auto e = bench.history().save(history_file, wall_s()))
+      std::cerr << "synbench serve: cannot save " << history_file.string() << ": " << e.message() << "\n";
+  };
+  http::add_telemetry_routes(router, bench.history(), worker);
 
   boost::asio::io_context io(1);
   http::HttpServer server(io, router, http::ServerLimits{},
@@ -190,6 +206,16 @@ int serve_command(const std::vector<std::string>& argv) {
   });
   metrics.set_connection_source([&server] { return http::ConnectionCounts{server.connections(), server.evicted()}; });
   hub->start();
+  boost::asio::steady_timer history_timer(io);
+  std::function<void()> save_history_later = [&] {
+    history_timer.expires_after(std::chrono::seconds(30));
+    history_timer.async_wait([&](const boost::system::error_code& e) {
+      if (e) return;
+      worker.post(save_history);
+      save_history_later();
+    });
+  };
+  save_history_later();
   if (auto e = server.listen(host, port)) {
     std::cerr << "synbench serve: cannot listen on " << host << ":" << port << ": " << e.message() << "\n";
     return 1;
@@ -209,6 +235,7 @@ int serve_command(const std::vector<std::string>& argv) {
           bench.shutdown();
           boost::asio::post(io, [&] {
             server.close();
+            history_timer.cancel();
             hub->stop();
             io.stop();
           });
@@ -239,6 +266,7 @@ int serve_command(const std::vector<std::string>& argv) {
   worker.stop();  // its answers go to the io_context, which must outlive them
   if (stopper.joinable()) stopper.join();
   bench.shutdown();
+  save_history();
   std::cerr << "synbench serve: stopped\n";
   return 0;
 }

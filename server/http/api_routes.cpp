@@ -109,6 +109,7 @@ synbench::Json status_json(const BenchStatus& s) {
   j["stopping"] = s.stopping;
   j["heartbeats"] = s.heartbeats;
   j["setpoints"] = {{"speed_rpm", s.setpoints.speed_rpm}, {"load_Nm", s.setpoints.load_Nm}, {"angle_deg", s.setpoints.angle_deg}};
+  j["commanded"] = {{"speed_rpm", s.commanded.speed_rpm}, {"load_Nm", s.commanded.load_Nm}, {"angle_deg", s.commanded.angle_deg}};
   j["mode"] = {{"estimator", std::string(drivers::name(s.mode.estimator))}, {"pwm", std::string(drivers::name(s.mode.pwm))}};
   if (s.synrm) {
     const auto& t = *s.synrm;
@@ -137,11 +138,18 @@ synbench::Json status_json(const BenchStatus& s) {
   j["supervisor"]["alarm"] = s.alarm ? synbench::Json{{"detail", s.alarm->detail}, {"at_s", s.alarm->at_s}} : synbench::Json(nullptr);
   j["supervisor"]["disable"] = s.disable ? disable_json(*s.disable) : synbench::Json(nullptr);
   j["loop"] = {{"ticks", s.ticks}, {"overruns", s.overruns}};
-  if (s.sweep)
+  if (s.sweep) {
     j["sweep"] = {{"id", s.sweep->id}, {"state", s.sweep->state}, {"done", s.sweep->done}, {"total", s.sweep->total},
                   {"error", s.sweep->error}};
-  else
+    j["sweep"]["current_index"] = s.sweep->current_index ? synbench::Json(*s.sweep->current_index) : synbench::Json(nullptr);
+    if (const auto& p = s.sweep->point)
+      j["sweep"]["point"] = {{"speed_rpm", p->speed_rpm}, {"load_Nm", p->load_Nm}, {"angle_deg", p->angle_deg},
+                             {"estimator", std::string(drivers::name(p->estimator))}, {"pwm", std::string(drivers::name(p->pwm))}};
+    else
+      j["sweep"]["point"] = nullptr;
+  } else {
     j["sweep"] = nullptr;
+  }
   synbench::Json ev = synbench::Json::array();
   for (const auto& e : s.events) ev.push_back({{"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
   j["events"] = ev;

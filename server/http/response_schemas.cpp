@@ -57,6 +57,7 @@ synbench::Json status_schema() {
        {"stopping", kBool},
        {"heartbeats", kBool},
        {"setpoints", closed_object({{"speed_rpm", kNum}, {"load_Nm", kNum}, {"angle_deg", kNum}})},
+       {"commanded", closed_object({{"speed_rpm", kNum}, {"load_Nm", kNum}, {"angle_deg", kNum}})},
        {"mode", closed_object({{"estimator", kStr}, {"pwm", kStr}})},
        {"synrm", closed_object({{"speed_rpm", kNum}, {"im_A", kNum}, {"id_A", kNum}, {"iq_A", kNum}, {"ud_V", kNum},
                                 {"uq_V", kNum}, {"udc_V", kNum}, {"pac_W", kNum}, {"temp_C", nullable(kNum)},
@@ -75,7 +76,12 @@ synbench::Json status_schema() {
                        {"disable", disable_schema()}},
                       false, {"trip"})},
        {"loop", closed_object({{"ticks", kInt}, {"overruns", kInt}})},
-       {"sweep", closed_object({{"id", kInt}, {"state", kStr}, {"done", kInt}, {"total", kInt}, {"error", kStr}}, true)},
+       {"sweep", closed_object({{"id", kInt}, {"state", kStr}, {"done", kInt}, {"total", kInt}, {"error", kStr},
+                                {"current_index", nullable(kInt)},
+                                {"point", closed_object({{"speed_rpm", kNum}, {"load_Nm", kNum}, {"angle_deg", kNum},
+                                                         {"estimator", kStr}, {"pwm", kStr}},
+                                                        true)}},
+                               true)},
        {"events", {{"type", "array"}, {"items", closed_object({{"t_s", kNum}, {"kind", kStr}, {"message", kStr}})}}}});
 }
 

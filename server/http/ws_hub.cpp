@@ -37,6 +37,10 @@ std::string telemetry_message(const BenchStatus& s, double sent_unix_ms) {
   j["voltage_limited"] = s.synrm ? synbench::Json(s.synrm->voltage_limited) : null;
   j["lock_lost"] = s.synrm ? synbench::Json(s.synrm->lock_lost) : null;
   j["fault"] = s.synrm ? synbench::Json(std::string(drivers::fault_name(s.synrm->fault))) : null;
+  // What the bench commands now (a sweep's point, its load ramp, a stop), not the manual setpoints.
+  j["cmd_speed_rpm"] = s.commanded.speed_rpm;
+  j["cmd_load_Nm"] = s.commanded.load_Nm;
+  j["cmd_angle_deg"] = s.commanded.angle_deg;
   return dump_json(j);
 }
 
@@ -132,12 +136,13 @@ void WsHub::on_tick() {
   }
   last_event_seq_ = max_seq;
   // A state message whenever what GET /api/bench/status shows changes, telemetry aside: enable,
-  // stop, phase, trip, setpoints, mode, sweep state, a new event. So a page need not poll.
+  // stop, phase, trip, setpoints, mode, sweep state or point, a new event. So a page need not poll.
   const std::string state_key =
       std::to_string(s.enabled) + std::to_string(s.stopping) + phase_name(s.phase) + std::to_string(s.trip.has_value()) +
       std::to_string(s.alarm.has_value()) + std::to_string(s.heartbeats) +
       "|" + std::to_string(s.setpoints.speed_rpm) + "," + std::to_string(s.setpoints.load_Nm) + "," +
       std::to_string(s.setpoints.angle_deg) + "|" + std::string(drivers::name(s.mode.estimator)) +
+      (s.sweep && s.sweep->current_index ? std::to_string(*s.sweep->current_index) : std::string()) +
       std::string(drivers::name(s.mode.pwm)) + "|" + (s.sweep ? std::to_string(s.sweep->id) + s.sweep->state : "") + "|" +
       std::to_string(max_seq);
   if (build && primed_ && state_key != last_state_key_) tick->events.push_back(share(state_message(s)));

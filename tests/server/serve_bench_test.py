@@ -8,8 +8,9 @@ The daemon answers a command once it has acted on it, so what a command does is 
 registers as soon as its reply arrives (the ordered stop and the spin-up excepted: they take
 time by design). For each link:
  1. enable over REST: both drives' state registers read running;
- 2. setpoints over REST (600 rpm, 1 N m, 50 deg): the setpoint registers hold them, the
-    heartbeat registers change, the shaft turns at 600 rpm;
+ 2. setpoints over REST (600 rpm, 1 N m, 50 deg): the setpoint registers hold them (and the
+    status's `commanded` says what they hold), the heartbeat registers change, the shaft turns
+    at 600 rpm;
  3. disable (the ordered stop): both drives read disabled;
  4. a sweep started over REST: the drives run it;
  5. E-stop while it runs: both drives read disabled within 1 s of the request, stay disabled,
@@ -164,6 +165,9 @@ def run_link(kind, tmp):
         check(sp[0] == SPEED and abs(sp[1] - ANGLE) < 0.006 and sp[2] == LOAD_NM,
               "%s: setpoint registers when the reply arrives: speed %.1f rpm (SynRM holding 16-17 f32), angle %.2f deg (holding 18 i16 "
               "x0.01), torque %.2f N m (load holding 16-17 f32)" % (kind, sp[0], sp[1], sp[2]))
+        cmd = (body or {}).get("commanded", {}) if isinstance(body, dict) else {}
+        check(cmd.get("speed_rpm") == sp[0] and abs(cmd.get("angle_deg", -1) - sp[1]) < 0.006 and cmd.get("load_Nm") == sp[2],
+              "%s: the status's commanded setpoints are what the registers hold (%s)" % (kind, cmd))
         spun = wait_for(lambda: running_at(far, SPEED, 0.05 * SPEED), spin_timeout(far), 0.1)
         check(spun, "%s: the shaft turns at %.0f rpm (SynRM input 16-17 f32: %.1f rpm), %s"
               % (kind, SPEED, far.speed_rpm(), fs.describe(far.states())))
@@ -231,6 +235,10 @@ def run_link(kind, tmp):
         zeroed = wait_for(lambda: far.speed_setpoint_rpm() == 0.0 and far.torque_setpoint_Nm() == 0.0, 2.0, 0.05)
         check(zeroed, "%s: after the disable the setpoint registers read zero: speed %.1f rpm (SynRM holding 16-17), "
                       "torque %.2f N m (load holding 16-17)" % (kind, far.speed_setpoint_rpm(), far.torque_setpoint_Nm()))
+        _, st = serve.request("GET", "/api/bench/status")
+        cmd = st.get("commanded", {}) if isinstance(st, dict) else {}
+        check(cmd.get("speed_rpm") == 0.0 and cmd.get("load_Nm") == 0.0,
+              "%s: and the status's commanded setpoints say so (%s)" % (kind, cmd))
         ended = wait_for(lambda: sweep_state(serve, sid) != "running", 10, 0.2)
         check(ended, "%s: the sweep stops running (%s)" % (kind, sweep_state(serve, sid)))
 

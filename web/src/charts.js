@@ -5,13 +5,14 @@ import * as echarts from 'echarts/core';
 import { LineChart, HeatmapChart, BarChart, ScatterChart } from 'echarts/charts';
 import {
   GridComponent, TooltipComponent, LegendComponent, VisualMapComponent, TitleComponent, DataZoomComponent,
+  MarkLineComponent,
 } from 'echarts/components';
 import { CanvasRenderer } from 'echarts/renderers';
 import { saveBlob } from './api.js';
 import { exportTitledPng } from './export_png.js';
 
 echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, GridComponent, TooltipComponent, LegendComponent,
-  VisualMapComponent, TitleComponent, DataZoomComponent, CanvasRenderer]);
+  VisualMapComponent, TitleComponent, DataZoomComponent, MarkLineComponent, CanvasRenderer]);
 
 // Okabe-Ito based palette: distinguishable with colour-blindness, dark enough on white.
 export const PALETTE = ['#0b57d0', '#d55e00', '#009e73', '#cc79a7', '#7a5c00', '#56b4e9', '#6a3d9a', '#000000'];

@@ -118,7 +118,7 @@ TEST(HubMessages, NullsWhileTheLinkIsDown) {
   EXPECT_EQ(t["phase"], "normal");
   const auto sw = sweep_json(s, std::nullopt);
   EXPECT_TRUE(sw["id"].is_null());
-  s.sweep = app::SweepInfo{4, "running", 2, 10, ""};
+  s.sweep = app::SweepInfo{4, "running", 2, 10, "", std::nullopt, std::nullopt};
   EXPECT_EQ(sweep_json(s, 8.0)["eta_s"], 8.0);
   const auto e = synbench::Json::parse(event_message(BenchEvent{1.5, "fault", "overcurrent", 7}));
   EXPECT_EQ(e["seq"], 7);

@@ -1,24 +1,37 @@
-// Live view: time-series charts of the telemetry (last 60 s of bench time), the readout, bench
-// control (setpoints, enable / ordered stop, reset, estimator and PWM, control lock) and events.
+// Live view: time-series charts of the telemetry (a chosen span of bench time, filled from the
+// daemon's history on load, reconnect and after a restart), the scope controls (scope.js), the
+// readout (the sweep that runs, the last stop's disable), bench control (setpoints, enable /
+// ordered stop, reset, estimator and PWM, control lock; disabled while a sweep owns the bench),
+// the feed of the sweep's last points (live_sweep.js) and events.
 import { ChartCard, axis } from '../charts.js';
 import { api } from '../api.js';
 import { faultText } from '../link.js';
 import { ESTIMATORS } from '../plan.js';
+import { Scope, tooltipFormatter, timeText } from '../scope.js';
+import { SweepFeed, sweepRows, sweepActive } from './live_sweep.js';
 
-const WINDOW_S = 60;
-const KEEP_S = 120;
+const KEEP_S = 930;   // the longest span (15 min) and a margin
+const GAP_S = 1;      // samples further apart: the line breaks (a daemon restart, a dropped link)
 const $ = (s) => document.querySelector(s);
 const fmt = (v, d = 1) => (v == null || !Number.isFinite(v) ? '–' : (Math.abs(v) < 0.5 * 10 ** -d ? 0 : v).toFixed(d));
 
+// Setpoints are what the bench commands now (telemetry cmd_*): a sweep's point, its load ramp.
 const CHARTS = [
-  { id: 'speed', title: 'Speed', unit: 'rpm', series: [['speed_rpm', 'measured'], ['sp_speed', 'setpoint', true]], d: 0, span: 100 },
-  { id: 'torque', title: 'Load torque', unit: 'N m', series: [['torque_Nm', 'T_L'], ['sp_load', 'setpoint', true]], d: 2, span: 0.5 },
+  { id: 'speed', title: 'Speed', unit: 'rpm', series: [['speed_rpm', 'measured'], ['cmd_speed_rpm', 'setpoint', true]], d: 0, span: 100 },
+  { id: 'torque', title: 'Load torque', unit: 'N m', series: [['torque_Nm', 'T_L'], ['cmd_load_Nm', 'setpoint', true]], d: 2, span: 0.5 },
+  { id: 'angle', title: 'Current angle θ_i', unit: 'deg', series: [['theta_i_deg', 'measured'], ['cmd_angle_deg', 'setpoint', true]], d: 1, span: 5 },
   { id: 'currents', title: 'Currents', unit: 'A', series: [['im_A', 'I_m'], ['id_A', 'i_d'], ['iq_A', 'i_q']], d: 2, span: 0.5 },
   { id: 'udc', title: 'DC bus U_dc', unit: 'V', series: [['udc_V', 'U_dc']], d: 1, span: 10 },
   { id: 'pdc', title: 'P_dcM', unit: 'W', series: [['pdc_W', 'P_dcM']], d: 1, span: 20 },  // falls back to the drive's P_ac estimate
   { id: 'temp', title: 'Winding temperature', unit: '°C', series: [['temp_C', 'temperature']], d: 1, span: 2 },
   { id: 'poserr', title: 'Position error', unit: 'deg', series: [['pos_err_deg', 'θ̂ − θ']], d: 2, span: 1, empty: 'no live position error (the encoder is the source, or the daemon does not send it)' },
 ];
+// The CSV's columns: the sample's keys carry their units.
+const CSV_COLUMNS = ['t_s', 'speed_rpm', 'cmd_speed_rpm', 'torque_Nm', 'cmd_load_Nm', 'theta_i_deg', 'cmd_angle_deg', 'im_A', 'id_A', 'iq_A',
+  'udc_V', 'pdc_W', 'temp_C', 'pos_err_deg'].map((k) => [k, k]);
+
+// The measured current angle atan2(|i_q|, i_d) (docs/record.md angle_meas_deg); none below 0.1 A.
+const thetaI = (id, iq) => (id == null || iq == null || Math.hypot(id, iq) < 0.1 ? null : (Math.atan2(Math.abs(iq), id) * 180) / Math.PI);
 
 export class LiveView {
   constructor(app) {
@@ -27,6 +40,13 @@ export class LiveView {
     this.cards = new Map();
     this.dirty = false;
     this.lastT = -Infinity;
+    app.live = this; // for the end-to-end tests
+    this.scope = new Scope($('#scope-bar'), CHARTS, {
+      onChange: () => { this.dirty = true; this.render(true); },
+      samples: () => this.buf,
+      csvColumns: CSV_COLUMNS,
+    });
+    this.feed = new SweepFeed();
     const host = $('#live-charts');
     for (const c of CHARTS) {
       const div = document.createElement('div');
@@ -38,10 +58,13 @@ export class LiveView {
     this.fillEstimators(false);
     app.on('telemetry', (t) => this.onTelemetry(t));
     app.on('status', (st) => this.onStatus(st));
+    app.on('sweep-progress', () => { if (app.status) { this.feed.update(app.status); this.renderReadout(); } });
     app.on('event', (e) => this.addEvents([e]));
     app.on('view', ({ view }) => { this.visible = view === 'live'; if (this.visible) this.dirty = true; });
-    app.on('refresh', () => { this.refreshLock(); if (!this.estimatorsFromDaemon) this.fillEstimators(true); });
-    setInterval(() => this.render(), 200);
+    app.on('refresh', () => { this.refreshLock(); this.fillHistory(); if (!this.estimatorsFromDaemon) this.fillEstimators(true); });
+    // Long spans redraw once a second: 15 min are 18000 samples a series.
+    setInterval(() => { if (this.scope.span_s <= 60 || ++this.slow % 5 === 0) this.render(); }, 200);
+    this.slow = 0;
     setInterval(() => { if (this.visible && app.role) this.refreshLock(); }, 5000);
 
     $('#setpoints-form').addEventListener('submit', (e) => {
@@ -86,11 +109,11 @@ export class LiveView {
 
   onTelemetry(t) {
     if (t.t_s == null || t.t_s <= this.lastT) {
-      if (t.t_s != null && t.t_s < this.lastT - 1) { this.buf = []; this.events = []; } // bench clock restarted (daemon restart)
+      if (t.t_s != null && t.t_s < this.lastT - 1) { this.buf = []; this.events = []; } // bench clock restarted: the history refills it
       else return;
     }
     this.lastT = t.t_s;
-    const sp = this.app.status?.setpoints || {};
+    const cmd = this.app.status?.commanded || {};
     // Live P_dcM when the daemon sends it; else the drive's own output-power estimate P_ac
     // (the VFC meter measures P_dcM only over a point's window).
     const pdcLive = t.pdc_W != null;
@@ -100,7 +123,10 @@ export class LiveView {
       h.textContent = pdcLive ? 'P_dcM [W]' : 'Drive power P_ac [W]';
       h.title = pdcLive ? 'DC power into the SynRM drive' : 'The drive\'s own output-power estimate: the daemon sends no live P_dcM (the VFC meter measures it over each point\'s window)';
     }
-    const sample = { ...t, pdc_W: t.pdc_W ?? t.pac_W ?? null, sp_speed: sp.speed_rpm, sp_load: sp.load_Nm };
+    const sample = {
+      ...t, pdc_W: t.pdc_W ?? t.pac_W ?? null, theta_i_deg: thetaI(t.id_A, t.iq_A),
+      cmd_speed_rpm: t.cmd_speed_rpm ?? cmd.speed_rpm, cmd_load_Nm: t.cmd_load_Nm ?? cmd.load_Nm, cmd_angle_deg: t.cmd_angle_deg ?? cmd.angle_deg,
+    };
     this.buf.push(sample);
     const cut = t.t_s - KEEP_S;
     if (this.buf.length > 50 && this.buf[0].t_s < cut) this.buf = this.buf.filter((s) => s.t_s >= cut);
@@ -108,41 +134,96 @@ export class LiveView {
     this.dirty = true;
   }
 
-  render() {
-    if (!this.visible || !this.dirty) return;
+  // The daemon's telemetry ring (GET /api/telemetry/history): the charts full at once on load,
+  // on reconnect and after a daemon restart (its old trace before a gap); live samples newer than
+  // the history's newest are kept.
+  async fillHistory() {
+    let h;
+    try { h = await api('GET', '/api/telemetry/history?span_s=900', undefined, { quiet401: true }); } catch { return; }
+    if (!h || !Array.isArray(h.t_s) || !h.t_s.length) return;
+    const c = h.channels || {};
+    const rows = h.t_s.map((t, i) => {
+      const s = { t_s: t, source: 'history' };
+      for (const k of Object.keys(c)) s[k] = c[k][i];
+      s.pdc_W = s.pdc_W ?? s.pac_W ?? null;
+      s.theta_i_deg = thetaI(s.id_A, s.iq_A);
+      return s;
+    });
+    const newest = rows[rows.length - 1].t_s;
+    this.buf = rows.concat(this.buf.filter((s) => s.t_s > newest));
+    this.lastT = this.buf[this.buf.length - 1].t_s;
+    this.latest = this.latest || rows[rows.length - 1];
+    this.dirty = true;
+    this.render(true);
+  }
+
+  render(force = false) {
+    if (!this.visible || (!this.dirty && !force)) return;
     this.dirty = false;
     this.renderReadout();
-    // A strip chart: 0..60 s for the first minute, then the last 60 s.
-    const t1 = Math.max(this.lastT, WINDOW_S);
-    const t0 = t1 - WINDOW_S;
-    const rows = this.buf.filter((s) => s.t_s >= t0);
+    if (this.scope.frozen && !force) return; // the buffer keeps filling; unfreezing catches up
+    if (this.scope.frozen && this.frozenAt != null) { this.draw(this.frozenAt); return; }
+    this.frozenAt = this.scope.frozen ? this.lastT : null;
+    this.draw(this.lastT);
+  }
+
+  // The charts up to bench time `tEnd`: the chosen span, or the whole buffer when it is shorter.
+  draw(tEnd) {
+    const span = this.scope.span_s;
+    const first = this.buf.length ? this.buf[0].t_s : 0;
+    const t1 = Math.max(tEnd, first + span);
+    const t0 = t1 - span;
+    const rows = this.buf.filter((s) => s.t_s >= t0 && s.t_s <= tEnd);
     for (const c of CHARTS) {
       const card = this.cards.get(c.id);
-      const series = c.series.map(([key, name, dashed]) => ({
+      const shown = this.scope.shown(c.id);
+      card.card.hidden = !shown;
+      if (!shown) continue;
+      const series = c.series.map(([key, name, dashed], i) => ({
         name, type: 'line', showSymbol: false, sampling: 'lttb', connectNulls: false,
         lineStyle: { width: dashed ? 1.5 : 2, type: dashed ? 'dashed' : 'solid' },
-        data: rows.map((s) => [s.t_s, s[key] ?? null]),
+        data: withGaps(rows, key),
+        ...(i === 0 ? { markLine: this.scope.markLine() } : {}),
       }));
       if (!card.chart) {
         card.set({
           legend: c.series.length > 1 ? { top: 0, right: 70, textStyle: { color: '#14181f' } } : undefined,
           grid: { left: 52, right: 12, top: 26, bottom: 26 },
+          tooltip: { trigger: 'axis', confine: true, formatter: tooltipFormatter(c.unit) },
+          dataZoom: [{ type: 'inside', xAxisIndex: 0, filterMode: 'none' }],
           xAxis: axis('', { min: t0, max: t1, splitNumber: 4, axisLabel: { color: '#333b47', formatter: clock } }),
           // at least `span` of range, so noise around a constant does not fill the chart
           yAxis: axis('', { min: (v) => niceLo(v, c.span), max: (v) => niceHi(v, c.span) }),
           series,
         }, { empty: c.empty || 'waiting for telemetry' });
+        // A click sets a cursor at the clicked bench time.
+        card.chart.getZr().on('click', (e) => {
+          const [t] = card.chart.convertFromPixel({ gridIndex: 0 }, [e.offsetX, e.offsetY]);
+          if (Number.isFinite(t)) this.scope.addCursor(t);
+        });
       } else {
-        card.update({ xAxis: { min: t0, max: t1 }, series: series.map((s) => ({ data: s.data })) });
+        card.update({ xAxis: { min: t0, max: t1 }, series: series.map((s) => ({ data: s.data, ...(s.markLine ? { markLine: s.markLine } : {}) })) });
       }
+      card.card.dataset.firstX = rows.length ? String(rows[0].t_s) : '';
+      card.card.dataset.lastX = rows.length ? String(rows[rows.length - 1].t_s) : '';
       const v = this.latest?.[c.series[0][0]];
       card.value(v == null ? '–' : `${fmt(v, c.d)} ${c.unit}`);
     }
+    this.scope.renderCursors();
+  }
+
+  // The last value drawn of a chart's series (the end-to-end tests read the chart itself).
+  drawnLast(chartId, seriesName) {
+    const chart = this.cards.get(chartId)?.chart;
+    const s = chart?.getOption().series.find((x) => x.name === seriesName);
+    const d = s?.data?.filter((p) => p[1] != null);
+    return d?.length ? d[d.length - 1][1] : null;
   }
 
   onStatus(st) {
     this.status = st;
     this.renderReadout();
+    this.feed.update(st);
     const f = $('#setpoints-form');
     if (!this.spEdited && !f.contains(document.activeElement) && st.setpoints) {
       f.speed_rpm.value = st.setpoints.speed_rpm;
@@ -164,19 +245,24 @@ export class LiveView {
     const s = st.synrm || {};
     const t = this.latest && this.latest.t_s >= (st.t_s ?? 0) - 2 ? this.latest : null;
     const v = (k, sk = k) => (t && t[k] != null ? t[k] : s[sk]);
+    const sweep = sweepRows(st);
     const rows = [
-      ['state', (t ? t.enabled : st.enabled) ? 'enabled' : 'disabled'],
+      ...(sweep.length ? sweep : [['state', (t ? t.enabled : st.enabled) ? 'enabled' : 'disabled']]),
       ['phase', (t && t.phase) || st.supervisor?.phase || '–'],
       ['speed', `${fmt(v('speed_rpm'), 0)} rpm`],
       ['I_m', `${fmt(v('im_A'), 2)} A`],
       ['load', `${fmt(t?.torque_Nm ?? st.load?.torque_Nm, 2)} N m`],
       ['U_dc', `${fmt(v('udc_V'), 1)} V`],
       ['temperature', `${fmt(v('temp_C'), 1)} °C`],
-      ['setpoints', `${fmt(st.setpoints?.speed_rpm, 0)} rpm, ${fmt(st.setpoints?.load_Nm, 2)} N m, ${fmt(st.setpoints?.angle_deg, 1)}°`],
+      [sweepActive(st) ? 'commanded' : 'setpoints', sweepActive(st) && st.commanded
+        ? `${fmt(st.commanded.speed_rpm, 0)} rpm, ${fmt(st.commanded.load_Nm, 2)} N m, ${fmt(st.commanded.angle_deg, 1)}°`
+        : `${fmt(st.setpoints?.speed_rpm, 0)} rpm, ${fmt(st.setpoints?.load_Nm, 2)} N m, ${fmt(st.setpoints?.angle_deg, 1)}°`],
     ];
     if (st.mode || st.estimator) rows.push(['estimator', `${st.mode?.estimator || st.estimator} / ${st.mode?.pwm || st.pwm || ''}`]);
     if (st.supervisor?.trip) rows.push(['trip', `${faultText(st.supervisor.trip.fault, st.supervisor.trip.fault_code_raw)}: ${st.supervisor.trip.detail}`]);
     if (st.supervisor?.alarm) rows.push(['ALARM', st.supervisor.alarm.detail]);
+    const dis = st.supervisor?.disable;
+    if (dis) rows.push(['disable', disableText(dis)]);
     if (st.heartbeats === false) rows.push(['heartbeats', "stopped until reset: the drives' watchdogs are armed"]);
     const html = rows.map(([k, val]) => `<dt>${k}</dt><dd data-k="${k}">${escapeHtml(String(val))}</dd>`).join('');
     if (html !== this.readoutHtml) { this.readoutHtml = html; $('#readout').innerHTML = html; }
@@ -207,6 +293,24 @@ export class LiveView {
   }
 }
 
+// The last stop's disable (status supervisor.disable): both read back, or per drive what is open.
+function disableText(d) {
+  if (d.confirmed) return `both drives read back disabled (stop at ${timeText(d.at_s)})`;
+  const one = (label, x) => `${label} ${x.state}${x.attempts > 1 ? ` (${x.attempts} tries)` : ''}${x.error ? `: ${x.error}` : ''}`;
+  return `not confirmed: ${one('SynRM', d.synrm)}, ${one('load', d.load)}`;
+}
+
+// [t, value] pairs, a null after a sample followed by a gap, so the line breaks there.
+function withGaps(rows, key) {
+  const out = [];
+  for (let i = 0; i < rows.length; i++) {
+    const s = rows[i];
+    out.push([s.t_s, s[key] ?? null]);
+    if (i + 1 < rows.length && rows[i + 1].t_s - s.t_s > GAP_S) out.push([s.t_s + GAP_S / 2, null]);
+  }
+  return out;
+}
+
 const eventKey = (e) => `${e.t_s}|${e.kind}|${e.message}`;
 
 // y range: at least `span`, widened to whole steps of a round number.
@@ -223,6 +327,7 @@ const niceLo = (v, span) => Number(niceRange(v, span)[0].toPrecision(6));
 const niceHi = (v, span) => Number(niceRange(v, span)[1].toPrecision(6));
 // bench time: "42 s", "12:05"
 function clock(v) {
+  if (v < 0) return `−${clock(-v)}`;
   if (v < 600) return `${Math.round(v)} s`;
   const m = Math.floor(v / 60);
   return `${m}:${String(Math.round(v - 60 * m)).padStart(2, '0')}`;
