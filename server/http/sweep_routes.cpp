@@ -358,7 +358,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                                  {"estimate", bench::to_json(bench::estimate(p))}});
                 };
                 add(bench::kThesisGridPreset,
-                    "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, encoder/CAPWM",
+                    "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, the thesis's eight "
+                    "configurations (HFI to 300 rpm, the EEMF variants from 500 rpm)",
                     bench::thesis_grid_plan());
                 add(bench::kIecPreset, "IEC 61800-9-2 drive operating points (speed %, torque %) at 40..76 deg step 2",
                     bench::iec_61800_9_2_plan());
