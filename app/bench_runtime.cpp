@@ -418,15 +418,15 @@ void BenchRuntime::start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<
       std::move(done));
 }
 
-void BenchRuntime::sweep_action(std::int64_t id, std::string action, Done done) {
+void BenchRuntime::sweep_action(std::int64_t id, std::string action, Done done, std::string reason) {
   submit(
-      [this, id, action](double) -> std::optional<Refusal> {
+      [this, id, action, reason](double) -> std::optional<Refusal> {
         if (!sweep_ || sweep_->id() != id)
           return Refusal{Refused::not_running, "sweep " + std::to_string(id) + " is not running on this bench"};
         if (action == "pause") sweep_->engine().pause();
         else if (action == "resume") sweep_->engine().resume();
-        else sweep_->engine().abort();
-        event("sweep", "sweep " + std::to_string(id) + " " + action);
+        else sweep_->engine().abort(reason);
+        event("sweep", "sweep " + std::to_string(id) + " " + action + (reason.empty() ? "" : ": " + reason));
         return std::nullopt;
       },
       std::move(done));
@@ -475,7 +475,7 @@ void BenchRuntime::shutdown(std::chrono::milliseconds timeout) {
     queue_.push_back({[this, timeout](double now_s) -> std::optional<Refusal> {
                         // A running sweep is aborted (its ordered stop, its state recorded);
                         // drives enabled by hand get the ordered stop.
-                        if (sweep_) sweep_->engine().abort();
+                        if (sweep_) sweep_->engine().abort("daemon stopped at " + db::now_utc());
                         begin_disable(now_s);
                         quit_ = true;
                         quit_deadline_ = std::chrono::steady_clock::now() + timeout;

@@ -97,8 +97,9 @@ class BenchRuntime {
   // skipping `stored` points; refused while the bench is enabled by hand, tripped or busy.
   void start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<std::size_t, bench::PointRecord> stored,
                    std::filesystem::path db_path, Done done);
-  // "pause", "resume" or "abort" of the running sweep `id`.
-  void sweep_action(std::int64_t id, std::string action, Done done);
+  // "pause", "resume" or "abort" of the running sweep `id`; an abort's reason (may be empty) is
+  // stored with the sweep as its error and named in the event.
+  void sweep_action(std::int64_t id, std::string action, Done done, std::string reason = {});
 
  private:
   using Act = std::function<std::optional<Refusal>(double now_s)>;

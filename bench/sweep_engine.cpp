@@ -78,8 +78,11 @@ void SweepEngine::resume() {
   if (state_ == SweepState::paused || state_ == SweepState::pausing) state_ = SweepState::running;
 }
 
-void SweepEngine::abort() {
-  if (!finished()) abort_requested_ = true;
+void SweepEngine::abort(const std::string& reason) {
+  if (finished()) return;
+  abort_requested_ = true;
+  // The first reason stays: a shutdown after an operator's abort does not overwrite theirs.
+  if (!reason.empty() && error_.empty()) error_ = reason;
 }
 
 std::optional<SweepEngine::Next> SweepEngine::next_point() {

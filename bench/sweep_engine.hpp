@@ -66,8 +66,10 @@ class SweepEngine {
   // Pause: finish the point in flight, then hold the bench where it is. Resume continues.
   void pause();
   void resume();
-  // Abort: drop the point in flight and bring the bench to its ordered stop.
-  void abort();
+  // Abort: drop the point in flight and bring the bench to its ordered stop. A reason (the
+  // operator's words, "daemon stopped at ...") becomes the sweep's error (its last_error in the
+  // store, named in the final event) with the state aborted.
+  void abort(const std::string& reason = {});
 
   SweepState state() const { return state_; }
   bool finished() const;

@@ -297,27 +297,36 @@ SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& m) {
   // The gate needs its span of (averaged) samples before it can pass.
   auto per_point_s = [&](const Configuration& c) {
     const double gate_s = plan.gate.bands.span_s + gate_average_s(plan, c);
-    return std::max(plan.gate.min_settle_s, gate_s) + m.settle_extra_s + plan.window_s;
+    return std::max(plan.gate.min_settle_s, gate_s) + plan.window_s + m.point_overhead_s;
+  };
+  const auto ordered_stop_s = [&](double speed_rpm, double load_Nm) {
+    return load_Nm / m.load_ramp_Nm_per_s + speed_rpm / m.speed_ramp_rpm_per_s + m.stop_s;
   };
   double speed = 0, load = 0, t = 0;
+  bool standstill = true;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const auto& s = steps[i];
     if (i > 0) {
+      if (s.speed_rpm != steps[i - 1].speed_rpm) ++e.speed_changes;
+      if (s.load_Nm != steps[i - 1].load_Nm) ++e.load_changes;
       if (!(s.config == steps[i - 1].config)) {
         ++e.configuration_changes;
-        t += m.configuration_change_s;
+        t += ordered_stop_s(speed, load);
+        speed = load = 0;
+        standstill = true;
       }
-      if (s.speed_rpm != speed) ++e.speed_changes;
-      if (s.load_Nm != load) ++e.load_changes;
     }
-    t += std::fabs(s.speed_rpm - speed) / m.speed_ramp_rpm_per_s;
-    t += std::fabs(s.load_Nm - load) / m.load_ramp_Nm_per_s;
+    const double speed_ramp_s = std::fabs(s.speed_rpm - speed) / m.speed_ramp_rpm_per_s;
+    const double load_ramp_s = std::fabs(s.load_Nm - load) / m.load_ramp_Nm_per_s;
+    if (standstill) t += speed_ramp_s + load_ramp_s + m.ramp_settle_s;  // spin-up, then the load
+    else if (speed_ramp_s > 0 || load_ramp_s > 0) t += std::max(speed_ramp_s, load_ramp_s) + m.ramp_settle_s;
+    else t += m.angle_settle_s;
     t += per_point_s(s.config);
     speed = s.speed_rpm;
     load = s.load_Nm;
+    standstill = false;
   }
-  // Back to standstill at the end.
-  t += load / m.load_ramp_Nm_per_s + speed / m.speed_ramp_rpm_per_s;
+  if (!steps.empty()) t += ordered_stop_s(speed, load);  // back to standstill at the end
   e.bench_time_s = t;
   return e;
 }

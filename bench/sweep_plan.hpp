@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bench/load_ramp.hpp"
 #include "bench/point_procedure.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/steady_state.hpp"
@@ -156,16 +157,28 @@ double gate_average_s(const SweepPlan& plan, const Configuration& c);
 // The safety supervisor's limits from the plan's (those SafetyLimits has).
 SafetyLimits safety_limits(const SweepPlan& plan);
 
-// Bench-time model (docs/sweep-plan.md): per point, settling (the larger of the gate's
-// min_settle_s and span_s + the configuration's average_s, plus settle_extra_s) and the window; ramps for every speed and load
-// change (from and back to standstill at the ends); a fixed cost per configuration change (the
-// engine stops and restarts the drive to switch estimator or PWM). Thermal waits are not
-// included: they depend on the machine's state.
+// Bench-time model (docs/sweep-plan.md), after what the engine does with the drives kept running
+// between points (PointOptions::continue_running), fitted to real-time twin sweeps under
+// `synbench serve`:
+// - every point: the gate, max(min_settle_s, span_s + the configuration's average_s), then the
+//   window and point_overhead_s (commands and the window's results, a few 10 ms ticks);
+// - before it, what changed since the last point: a speed and / or load change ramps both at
+//   once (the firmware's speed ramp, the bench's own load ramp, bench/load_ramp.hpp) and the
+//   3 Hz speed loop then needs ramp_settle_s to come into the gate's 2 rpm band; an angle-only
+//   step needs angle_settle_s (on average: a few degrees cost nothing, 10 deg about 0.5 s);
+// - from standstill (the first point, and after each configuration change) the spin-up and the
+//   load ramp one after the other, then ramp_settle_s;
+// - an ordered stop at each configuration change (the engine stops the drives to switch
+//   estimator or PWM) and at the end: the load ramped off, the speed ramped down, stop_s to
+//   confirm both stopped.
+// Thermal waits and gate timeouts are not included: they depend on the machine's state.
 struct SweepTimeModel {
-  double speed_ramp_rpm_per_s = 1000.0;   // firmware speed ramp
-  double load_ramp_Nm_per_s = 10.0;       // load drive torque ramp
-  double settle_extra_s = 1.0;            // transients beyond the gate's minimum
-  double configuration_change_s = 10.0;   // ordered stop, switch, restart
+  double speed_ramp_rpm_per_s = 1000.0;                // firmware speed ramp
+  double load_ramp_Nm_per_s = kBenchLoadRamp_Nm_per_s;  // the bench ramps the load setpoint
+  double ramp_settle_s = 0.7;                          // speed loop after a speed / load ramp
+  double angle_settle_s = 0.25;                        // after an angle-only step
+  double point_overhead_s = 0.1;                       // commands, the window's results
+  double stop_s = 0.2;                                 // the ordered stop's confirmation
 };
 
 struct SweepEstimate {

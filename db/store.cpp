@@ -13,12 +13,6 @@
 
 namespace synbench::db {
 
-using detail::Statement;
-using detail::Transaction;
-
-namespace {
-
-// Wall-clock UTC with milliseconds, ISO 8601: sorts as text and SQLite's date functions read it.
 std::string now_utc() {
   using namespace std::chrono;
   const auto now = system_clock::now();
@@ -32,6 +26,12 @@ std::string now_utc() {
   std::snprintf(out, sizeof out, "%s.%03dZ", buf, static_cast<int>(ms));
   return out;
 }
+
+using detail::Statement;
+using detail::Transaction;
+
+namespace {
+
 
 std::optional<std::string> json_text(const synbench::Json& j) {
   if (j.is_null()) return std::nullopt;

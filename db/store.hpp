@@ -33,6 +33,10 @@
 
 namespace synbench::db {
 
+// Wall-clock UTC with milliseconds, ISO 8601 ("2026-12-04T05:01:02.345Z"): the store's
+// timestamps; sorts as text and SQLite's date functions read it.
+std::string now_utc();
+
 struct StoreOptions {
   int busy_timeout_ms = 5000;  // how long a write waits for another connection's lock
   // At open, PRAGMA quick_check (a file with damaged pages is refused, errc::corrupt) and a

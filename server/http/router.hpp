@@ -74,8 +74,9 @@ struct Route {
   // (json_schema.hpp) before the handler runs, with `body_error_code`.
   std::optional<synbench::Json> request_schema;
   std::string body_error_code = "bad_field";
-  // Set by Worker::offloaded only: the handler runs check_body itself on the worker thread, so
-  // that the io thread never parses a heavy route's (up to 64 KiB) body.
+  // Set by Worker::offloaded: the handler runs check_body itself on the worker thread, so
+  // that the io thread never parses a heavy route's (up to 64 KiB) body. Also set by a route
+  // whose body is optional (the sweep abort's reason): it checks a body only when one is given.
   bool body_checked_by_handler = false;
   std::optional<synbench::Json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
 };

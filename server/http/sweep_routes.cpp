@@ -11,6 +11,7 @@
 
 #include "bench/analysis.hpp"
 #include "bench/sweep_plan.hpp"
+#include "bench/sweep_plan_bench_limits.hpp"
 #include "bench/sweep_presets.hpp"
 #include "db/export.hpp"
 #include "server/http/api_routes.hpp"
@@ -56,6 +57,16 @@ Response bad_plan(const bench::SweepPlanParseResult& plan) {
   std::string message;
   for (const auto& e : plan.errors) message += (message.empty() ? "" : "; ") + bench::to_string(e);
   return error_response(400, "bad_plan", message.empty() ? "the plan does not parse" : message);
+}
+
+// A plan that parses but does not fit this bench (a speed above its drive's limit): as one 400,
+// every problem at its pointer, so create and estimate refuse what start would fault at.
+std::optional<Response> bad_for_bench(const synbench::Json& doc, const bench::SweepPlan& plan,
+                                      const bench::BenchSetpointLimits& limits) {
+  const bool from_preset = doc.is_object() && doc.contains("preset") && !doc.contains("dimensions");
+  const auto errors = bench::check_bench_limits(plan, limits, from_preset);
+  if (errors.empty()) return std::nullopt;
+  return bad_plan({std::nullopt, errors});
 }
 
 // "encoder/capwm" -> a configuration, for ?reference=.
@@ -157,6 +168,19 @@ Route plan_route(Route r) {
   return r;
 }
 
+// POST /api/sweeps/{id}/abort's optional body: why, in the operator's words.
+synbench::Json abort_schema() {
+  return {{"type", "object"},
+          {"additionalProperties", false},
+          {"properties", {{"reason", {{"type", "string"}, {"maxLength", 500}, {"description", "why the sweep is aborted"}}}}}};
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return {};
+  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
+}
+
 // A viewer may estimate plans up to this size; an operator up to the plan parser's own limit.
 constexpr std::size_t kViewerEstimatePoints = 100000;
 
@@ -174,6 +198,7 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
   db::Store* db = &store;
   BenchRuntime* runtime = &bench;
   ControlLock* lock = &control;
+  const bench::BenchSetpointLimits limits{bench.description().max_speed_rpm, bench.description().max_load_Nm};
   router.add({"POST", "/api/sweeps/{id}/start", Role::operator_,
               "Run the sweep on the daemon's bench (a stopped one resumes at its first missing point).",
               AsyncHandler([db, runtime, lock, db_path](const Request& req, Reply reply) {
@@ -197,22 +222,36 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
     const std::string a = action;
     const std::string summary = a == "pause"    ? "Pause the running sweep after its point in flight."
                                 : a == "resume" ? "Resume the paused sweep."
-                                                : "Abort the running sweep: drop the point in flight, ordered stop.";
-    router.add({"POST", "/api/sweeps/{id}/" + a, Role::operator_, summary,
-                AsyncHandler([runtime, lock, a](const Request& req, Reply reply) {
-                  if (!lock->claim(req.caller_id)) return reply(locked(*lock));
-                  Response err;
-                  const auto id = sweep_id(req, err);
-                  if (!id) return reply(err);
-                  runtime->sweep_action(*id, a, answer(std::move(reply)));
-                })});
+                                                : "Abort the running sweep: drop the point in flight, ordered stop. An "
+                                                  "optional body {\"reason\": \"...\"} is stored as the sweep's last_error "
+                                                  "and named in the events.";
+    Route r{"POST", "/api/sweeps/{id}/" + a, Role::operator_, summary,
+            AsyncHandler([runtime, lock, a](Request req, Reply reply) {
+              if (!lock->claim(req.caller_id)) return reply(locked(*lock));
+              Response err;
+              const auto id = sweep_id(req, err);
+              if (!id) return reply(err);
+              std::string reason;
+              // The body is optional (the CLI and older pages send none): checked here when given.
+              if (a == "abort" && !req.body.empty()) {
+                if (auto bad = check_body(abort_schema(), "bad_field", req)) return reply(std::move(*bad));
+                if (req.json.contains("reason")) reason = trim(req.json["reason"].get<std::string>());
+              }
+              runtime->sweep_action(*id, a, answer(std::move(reply)), std::move(reason));
+            })};
+    if (a == "abort") {
+      r.request_schema = abort_schema();
+      r.body_checked_by_handler = true;
+    }
+    router.add(std::move(r));
   }
   router.add(plan_route({"POST", "/api/sweeps", Role::operator_,
               "Create a sweep from a plan (docs/sweep-plan.md): 201 with its id, state created.",
-              [db, lock, bench_config](const Request& req) {
+              [db, lock, bench_config, limits](const Request& req) {
                 if (!lock->claim(req.caller_id)) return locked(*lock);
                 auto plan = bench::parse_sweep_plan(req.json);
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
+                if (auto bad = bad_for_bench(req.json, *plan.plan, limits)) return *bad;
                 db::SweepMeta meta;
                 meta.name = plan.plan->name.empty() ? "sweep" : plan.plan->name;
                 meta.plan = bench::to_json(*plan.plan);
@@ -319,7 +358,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                                  {"estimate", bench::to_json(bench::estimate(p))}});
                 };
                 add(bench::kThesisGridPreset,
-                    "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, encoder/CAPWM",
+                    "Thesis Sec. 6.3.2: 100..900 rpm step 200 x 0.5..3.5 N m step 0.5 x 40..76 deg step 2, the thesis's eight "
+                    "configurations (HFI to 300 rpm, the EEMF variants from 500 rpm)",
                     bench::thesis_grid_plan());
                 add(bench::kIecPreset, "IEC 61800-9-2 drive operating points (speed %, torque %) at 40..76 deg step 2",
                     bench::iec_61800_9_2_plan());
@@ -328,9 +368,10 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               presets_schema()));
   router.add(worker.offloaded(answering(plan_route({"POST", "/api/sweeps/estimate", Role::viewer,
               "Validate a plan without creating a sweep: its canonical form, number of points and bench time.",
-              [](const Request& req) {
+              [limits](const Request& req) {
                 auto plan = bench::parse_sweep_plan(req.json);
                 if (!plan.errors.empty() || !plan.plan) return bad_plan(plan);
+                if (auto bad = bad_for_bench(req.json, *plan.plan, limits)) return *bad;
                 if (req.caller != Role::operator_ && size_bound(*plan.plan) > kViewerEstimatePoints)
                   return error_response(413, "too_large", "a viewer may estimate plans of at most " +
                                                               std::to_string(kViewerEstimatePoints) + " points");

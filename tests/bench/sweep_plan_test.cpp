@@ -505,7 +505,8 @@ TEST(SweepPresets, ThesisGridAveragesTheGateOfTheInjectingConfigurations) {
   // Each averaged point waits for its mean before the span: 1.24 s more per point.
   const auto s = parse_ok(json::parse(R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50, 52],
     "configurations": [{"estimator": "hfi", "pwm": "capwm", "gate_average_s": 1.24}]}})"));
-  EXPECT_NEAR(estimate(s).bench_time_s - estimate(r).bench_time_s, 2 * 1.24 + 2.5, 1e-9);
+  // (and the second point its angle step and its own gate, window and overhead: 0.25 + 1.6 s).
+  EXPECT_NEAR(estimate(s).bench_time_s - estimate(r).bench_time_s, 2 * 1.24 + 0.25 + 1.6, 1e-9);
 }
 
 TEST(SweepPresets, ThesisGridWith23AnglesGives805PerConfiguration) {
@@ -560,9 +561,10 @@ TEST(SweepPlanEstimate, TimeModelByHand) {
   const auto e = estimate(p);
   EXPECT_EQ(e.points, 2u);
   EXPECT_EQ(e.groups, 1u);
-  // Spin-up 500 rpm at 1000 rpm/s (0.5 s), load 1 N m at 10 N m/s (0.1 s), two points of
-  // max(0.5, 0.5) + 1 + 1 s, and back to standstill (0.1 + 0.5 s).
-  EXPECT_DOUBLE_EQ(e.bench_time_s, 0.5 + 0.1 + 2 * 2.5 + 0.1 + 0.5);
+  // Spin-up 500 rpm at 1000 rpm/s (0.5 s), then load 1 N m at the bench's 2 N m/s (0.5 s) and the
+  // speed loop's 0.7 s; two points of max(0.5, 0.5) gate + 1 s window + 0.1 s, the second after
+  // its angle step (0.25 s); the ordered stop (0.5 + 0.5 + 0.2 s).
+  EXPECT_NEAR(e.bench_time_s, (0.5 + 0.5 + 0.7) + 1.6 + (0.25 + 1.6) + (0.5 + 0.5 + 0.2), 1e-9);
   EXPECT_EQ(e.speed_changes, 0u);
 
   const auto q = parse_ok(json::parse(R"({"dimensions": {"speed_rpm": [100, 300], "load_Nm": [1, 2],
@@ -573,9 +575,10 @@ TEST(SweepPlanEstimate, TimeModelByHand) {
   EXPECT_EQ(f.speed_changes, 1u);
   EXPECT_EQ(f.load_changes, 3u);          // 1 -> 2 at 100 rpm, 2 -> 1, 1 -> 2 at 300 rpm
   EXPECT_EQ(f.configuration_changes, 7u);  // config is inside load: it alternates every point
-  // Eight points of max(0.5, 0.5) + 1 + 2 s, seven configuration changes, speed ramps
-  // 0 -> 100 -> 300 -> 0 rpm (0.6 s), load ramps 0 -> 1 -> 2 -> 1 -> 2 -> 0 N m (0.6 s).
-  EXPECT_NEAR(f.bench_time_s, 8 * 3.5 + 7 * 10.0 + 0.6 + 0.6, 1e-9);
+  // Every point from standstill (the configuration changes each time) and an ordered stop after
+  // it: spin-up and stop at 100 rpm (4x) and 300 rpm (4x), load on and off 1 N m (4x) and 2 N m
+  // (4x) at 2 N m/s, 0.7 s settling and 0.2 s stop each, eight points of 0.5 + 2 + 0.1 s.
+  EXPECT_NEAR(f.bench_time_s, 2 * (4 * 0.1 + 4 * 0.3) + 2 * (4 * 0.5 + 4 * 1.0) + 8 * (0.7 + 0.2) + 8 * 2.6, 1e-9);
   const auto a = estimate(parse_ok(json::parse(R"({"preset": "thesis-grid", "mode": "adaptive"})")));
   EXPECT_TRUE(a.upper_bound);
   EXPECT_EQ(a.points, (4u * 35u + 14u + 3u * 21u) * 7u);

@@ -200,8 +200,10 @@ def main():
         s, data, _ = d.http("POST", "/api/sweeps", body=tiny, token=op)
         sid = json.loads(data)["id"]
         d.http("POST", "/api/sweeps/%d/start" % sid, token=op)
-        s, data, _ = d.http("POST", "/api/sweeps/%d/abort" % sid, token=op)
-        check(s == 200, "abort a running sweep")
+        s, data, _ = d.http("POST", "/api/sweeps/%d/abort" % sid, body={"reason": 5}, token=op)
+        check(s == 400 and "/reason" in data.decode(), "an abort reason that is not text -> 400 at /reason")
+        s, data, _ = d.http("POST", "/api/sweeps/%d/abort" % sid, body={"reason": "  rest test  "}, token=op)
+        check(s == 200, "abort a running sweep (with a reason)")
         deadline = time.time() + 30
         while time.time() < deadline:
             _, data, _ = d.http("GET", "/api/sweeps/%d" % sid, token=viewer)
@@ -210,6 +212,12 @@ def main():
                 break
             time.sleep(0.3)
         check(state == "aborted", "the aborted sweep is recorded aborted (%s)" % state)
+        check(json.loads(data)["last_error"] == "rest test", "the abort's reason is its last_error (%r)" % json.loads(data)["last_error"])
+        too_fast = dict(tiny, dimensions={"speed_rpm": [500, 1600], "load_Nm": [1.0], "angle_deg": [48]})
+        for route in ("/api/sweeps/estimate", "/api/sweeps"):
+            s, data, _ = d.http("POST", route, body=too_fast, token=op)
+            check(s == 400 and "/dimensions/speed_rpm: 1600 rpm exceeds the bench's max_speed_rpm (1500 rpm" in data.decode(),
+                  "%s refuses a speed above the drive's limit at its pointer: %s" % (route, data[:200]))
         s, data, _ = d.http("POST", "/api/sweeps/%d/pause" % sid, token=op)
         check(s == 409 and error_of(data)[0] == "not_running", "pause of a sweep not running -> 409")
 

@@ -1,26 +1,28 @@
-// Sweep view: the builder (presets, dimensions, mode, configurations, measurement, estimate) and
-// the progress of the current sweep (per-point status, ETA, efficiency map and trajectories
+// Sweep view: the builder (presets, dimensions, mode, configurations, measurement, estimate, the
+// plan checked against the bench's limits) and the progress of the current sweep (per-point
+// status cells, keyboard-reachable; ETA; abort with a reason; efficiency map and trajectories
 // filling in as points complete).
 import { api, ApiError } from '../api.js';
 import { ChartCard } from '../charts.js';
-import { ESTIMATORS, expandPlan, fmtDuration, values } from '../plan.js';
+import { ESTIMATORS, benchLimitErrors, describePlan, expandGroups, expandPlan, fmtDuration, values } from '../plan.js';
 import { effMapOption, trajectoriesOption, cfgLabel } from './plots.js';
 import { escapeHtml } from './live.js';
+import { ProgressCells } from './sweep_cells.js';
 
 const $ = (s) => document.querySelector(s);
 const ACTIVE = ['running', 'pausing', 'paused', 'stopping'];
 
 // Presets the page knows when the daemon has no GET /api/presets.
 const BUILTIN_PRESETS = [
-  { name: 'thesis-grid', description: 'Thesis Sec. 6.3.2: 100..900 rpm x 0.5..3.5 N m x 40..76 deg, eight configurations (4522 points, ~3.8 h).',
+  { name: 'thesis-grid',
     plan: { preset: 'thesis-grid', dimensions: { speed_rpm: { from: 100, to: 900, step: 200 }, load_Nm: { from: 0.5, to: 3.5, step: 0.5 }, angle_deg: { from: 40, to: 76, step: 2 },
       configurations: [{ estimator: 'encoder', pwm: 'capwm' }, { estimator: 'encoder', pwm: 'aspwm' }, { estimator: 'ekf-basic', pwm: 'aspwm' }, { estimator: 'ekf-rs', pwm: 'aspwm' },
         { estimator: 'hfi', pwm: 'capwm' }, { estimator: 'eemf-const', pwm: 'capwm', min_speed_rpm: 500 }, { estimator: 'eemf-lut', pwm: 'capwm', min_speed_rpm: 500 }, { estimator: 'eemf-rls', pwm: 'capwm', min_speed_rpm: 500 }] } } },
-  { name: 'iec-61800-9-2', description: 'The eight IEC 61800-9-2 operating points (0 % speed measured at 100 rpm), 40..76 deg, encoder/CAPWM (152 points).',
+  { name: 'iec-61800-9-2',
     plan: { preset: 'iec-61800-9-2', dimensions: { operating_points: [[100, 0.875], [100, 1.75], [100, 3.5], [750, 0.875], [750, 1.75], [750, 3.5], [1350, 1.75], [1350, 3.5]].map(([s, l]) => ({ speed_rpm: s, load_Nm: l })),
       angle_deg: { from: 40, to: 76, step: 2 }, configurations: [{ estimator: 'encoder', pwm: 'capwm' }] } } },
 ];
-const QUICK = { name: 'quick-twin-check', description: 'A small grid for a first look at the twin: 2 speeds x 2 loads x 3 angles, short window and gate (12 points, about a minute).',
+const QUICK = { name: 'quick-twin-check',
   plan: { name: 'quick twin check', dimensions: { speed_rpm: [300, 600], load_Nm: [1, 2], angle_deg: { from: 44, to: 64, step: 10 }, configurations: [{ estimator: 'encoder', pwm: 'capwm' }] },
     window_s: 0.2, gate: { span_s: 0.2, min_settle_s: 0.2, timeout_s: 3 }, thermal: { enabled: false } } };
 
@@ -41,6 +43,7 @@ export class SweepView {
     this.base = {};
     this.current = null;       // {id, meta, plan, points, analysis, expanded}
     this.buildDims();
+    this.cells = new ProgressCells($('#p-cells'), $('#p-cell-detail'));
     this.mapCard = new ChartCard($('[data-chart="p-map"]'), { title: 'Efficiency map (ME angle)' });
     this.trajCard = new ChartCard($('[data-chart="p-traj"]'), { title: 'MTPA / ME trajectories' });
     this.loadPresets(false);
@@ -52,7 +55,9 @@ export class SweepView {
     $('#b-add-config').addEventListener('click', () => { this.addConfig({ estimator: 'encoder', pwm: 'capwm' }); this.changed(); });
     form.addEventListener('submit', (e) => { e.preventDefault(); this.create(true); });
     $('#b-create').addEventListener('click', () => this.create(false));
-    for (const a of ['pause', 'resume', 'abort']) $(`#p-${a}`).addEventListener('click', () => this.action(a));
+    for (const a of ['pause', 'resume']) $(`#p-${a}`).addEventListener('click', () => this.action(a));
+    $('#p-abort').addEventListener('click', () => this.askAbort());
+    this.abortDialog();
     $('#p-restart').addEventListener('click', () => this.action('start'));
 
     app.on('view', ({ view, arg }) => {
@@ -62,8 +67,9 @@ export class SweepView {
     });
     app.on('status', (st) => this.onStatus(st));
     app.on('sweep-progress', (s) => this.onProgress(s));
-    app.on('refresh', () => { this.refreshCurrent(true); if (!this.presetsFromDaemon) this.loadPresets(true); });
-    app.on('role', () => this.renderButtons());
+    app.on('refresh', () => { this.refreshCurrent(true); if (!this.presetsFromDaemon) this.loadPresets(true); this.loadBenchConfig(); });
+    // Signed in (or the role changed): what was refused before the token is asked again.
+    app.on('role', () => { this.renderButtons(); this.loadBenchConfig(); this.changed(); });
     setInterval(() => { if (this.visible && this.current && ACTIVE.includes(this.current.state)) this.refreshCurrent(false); }, 2000);
   }
 
@@ -83,9 +89,11 @@ export class SweepView {
             <label>step<input data-role="step" type="number" step="any" aria-describedby="lbl-${key}"></label>
           </div>
           <div class="vals list" hidden><label>values<input data-role="list" type="text" inputmode="decimal" placeholder="e.g. 300, 600" title="comma-separated values" aria-describedby="lbl-${key}"></label></div>
+          <p class="field-error" id="b-err-${key}" role="alert" hidden></p>
         </div>`;
       }).join('')}
-      <label id="b-points-wrap" hidden>Operating points: one "speed_rpm load_Nm [label]" per line<textarea id="b-points" rows="5" spellcheck="false"></textarea></label>`);
+      <label id="b-points-wrap" hidden>Operating points: one "speed_rpm load_Nm [label]" per line<textarea id="b-points" rows="5" spellcheck="false"></textarea></label>
+      <p class="field-error" id="b-err-operating_points" role="alert" hidden></p>`);
     for (const row of fs.querySelectorAll('.dimrow')) {
       row.querySelector('[data-role="kind"]').addEventListener('change', (e) => this.setKind(row, e.target.value));
     }
@@ -171,7 +179,8 @@ export class SweepView {
 
   applyPreset(name) {
     const p = this.presets.find((x) => x.name === name);
-    $('#b-preset-desc').textContent = p ? p.description || '' : 'Edit any field below.';
+    // Derived from what the preset loads, never its hand-written text.
+    $('#b-preset-desc').textContent = p ? describePlan(p.plan) : 'Edit any field below.';
     if (!p) { this.changed(); return; }
     this.fillForm(p.plan, name);
   }
@@ -248,24 +257,56 @@ export class SweepView {
   changed() {
     const plan = this.planFromForm();
     $('#b-json').textContent = JSON.stringify(plan, null, 2);
+    this.showPlanErrors(benchLimitErrors(plan, this.benchConfig));
     clearTimeout(this.estTimer);
     this.estTimer = setTimeout(() => this.estimate(plan), 250);
+  }
+
+  async loadBenchConfig() {
+    try { this.benchConfig = await api('GET', '/api/bench/config', undefined, { quiet401: true }); } catch { return; }
+    this.showPlanErrors(benchLimitErrors(this.planFromForm(), this.benchConfig));
+  }
+
+  // Problems at their JSON pointers ({pointer, message}) shown at the field they name; any
+  // problem disables Create.
+  showPlanErrors(errors) {
+    const byField = new Map();
+    for (const e of errors) {
+      const key = /^\/dimensions\/(speed_rpm|load_Nm|angle_deg|operating_points)/.exec(e.pointer)?.[1];
+      if (!key) continue;
+      byField.set(key, [...(byField.get(key) || []), e.message]);
+    }
+    for (const key of ['speed_rpm', 'load_Nm', 'angle_deg', 'operating_points']) {
+      const el = $(`#b-err-${key}`);
+      const msgs = byField.get(key);
+      el.hidden = !msgs;
+      el.textContent = msgs ? msgs.join('; ') : '';
+      const inputs = key === 'operating_points' ? [$('#b-points')] : document.querySelectorAll(`.dimrow[data-dim="${key}"] input`);
+      for (const i of inputs) { if (msgs) { i.setAttribute('aria-invalid', 'true'); i.setAttribute('aria-errormessage', el.id); } else i.removeAttribute('aria-invalid'); }
+    }
+    this.planErrors = errors;
+    this.renderButtons();
   }
 
   async estimate(plan) {
     const el = $('#b-estimate');
     const seq = (this.estSeq = (this.estSeq || 0) + 1);
-    let text, bad = false;
+    let text, bad = false, errors = benchLimitErrors(plan, this.benchConfig);
     try {
       const r = await api('POST', '/api/sweeps/estimate', plan, { quiet401: true });
       text = `${r.points}${r.upper_bound || plan.mode === 'adaptive' ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time`;
       this.lastEstimate = r;
     } catch (e) {
       bad = true;
-      text = e instanceof ApiError && (e.code === 'bad_plan' || e.status === 400)
-        ? `Plan problems: ${e.message}` : `cannot estimate: ${e.message}`;
+      const planProblem = e instanceof ApiError && (e.code === 'bad_plan' || e.status === 400);
+      text = planProblem ? `Plan problems: ${e.message}` : `cannot estimate: ${e.message}`;
+      // "/dimensions/speed_rpm: 1600 rpm exceeds ...; /gate/span_s: ..." -> at their fields
+      if (planProblem) {
+        errors = e.message.split('; ').map((m) => /^(\/[^:]*): (.*)$/.exec(m)).filter(Boolean).map(([, pointer, message]) => ({ pointer, message }));
+      }
     }
     if (seq !== this.estSeq) return;
+    this.showPlanErrors(errors);
     el.textContent = text;
     el.classList.toggle('bad', bad);
     el.dataset.points = bad ? '' : String(this.lastEstimate?.points ?? '');
@@ -273,6 +314,7 @@ export class SweepView {
 
   async create(start) {
     const plan = this.planFromForm();
+    if (this.planErrors?.length) return;
     let s;
     try {
       s = await this.app.command('POST', '/api/sweeps', plan, start ? null : 'Sweep created');
@@ -283,10 +325,42 @@ export class SweepView {
   }
 
   // ---- progress --------------------------------------------------------------------------------
-  async action(a) {
+  // Abort asks first: Enter confirms (the reason field or the button), Esc or Cancel keeps the
+  // sweep running. Esc inside this dialog closes it and is no E-stop (its keydown stops here).
+  abortDialog() {
+    const dlg = $('#abort-dialog');
+    dlg.addEventListener('keydown', (e) => {
+      if (e.key !== 'Escape') return;
+      e.stopPropagation();
+      e.preventDefault();
+      dlg.close('cancel');
+    });
+    dlg.addEventListener('cancel', (e) => { e.preventDefault(); dlg.close('cancel'); });
+    $('#abort-cancel').addEventListener('click', () => dlg.close('cancel'));
+    $('#abort-form').addEventListener('submit', (e) => {
+      e.preventDefault();
+      dlg.close('confirm');
+    });
+    dlg.addEventListener('close', () => {
+      if (dlg.returnValue === 'confirm') this.action('abort', { reason: $('#abort-reason').value.trim() });
+      $('#p-abort').focus();
+    });
+  }
+
+  askAbort() {
+    if (!this.current) return;
+    const dlg = $('#abort-dialog');
+    $('#abort-title').textContent = `Abort sweep #${this.current.id}?`;
+    $('#abort-reason').value = '';
+    dlg.returnValue = '';
+    dlg.showModal();
+    $('#abort-reason').focus();
+  }
+
+  async action(a, body = {}) {
     if (!this.current) return;
     try {
-      await this.app.command('POST', `/api/sweeps/${this.current.id}/${a}`, {}, `Sweep ${this.current.id}: ${a}`);
+      await this.app.command('POST', `/api/sweeps/${this.current.id}/${a}`, body, `Sweep ${this.current.id}: ${a}`);
       this.followRunning = true;
     } catch { /* toast shown */ }
     this.refreshCurrent(true);
@@ -390,8 +464,9 @@ export class SweepView {
     $('#p-resume').disabled = !op || !c || st !== 'paused';
     $('#p-abort').disabled = !op || !c || !ACTIVE.includes(st);
     $('#p-restart').disabled = !op || !c || ACTIVE.includes(st) || st === 'completed';
-    $('#b-start').disabled = !op;
-    $('#b-create').disabled = !op;
+    const bad = !!this.planErrors?.length;
+    $('#b-start').disabled = !op || bad;
+    $('#b-create').disabled = !op || bad;
   }
 
   renderProgress() {
@@ -409,39 +484,21 @@ export class SweepView {
     $('#p-pct').dataset.pct = String(shownPct);
     const eta = this.eta();
     const parts = [`<span class="state ${c.state}" id="p-state">${c.state || '?'}</span>`, `${done} / ${total} points`];
-    if (ACTIVE.includes(c.state)) parts.push(`ETA ${eta == null ? 'estimating…' : fmtDuration(eta)}`);
+    // Paused, the time left does not run down: no counting ETA until it resumes.
+    if (c.state === 'paused') parts.push('<span id="p-eta">paused</span>');
+    else if (ACTIVE.includes(c.state)) parts.push(`<span id="p-eta">ETA ${eta == null ? 'estimating…' : fmtDuration(eta)}</span>`);
     if (c.meta?.plan?.mode === 'adaptive') parts.push('adaptive: total is an upper bound');
-    if (c.error) parts.push(`<span class="error">${escapeHtml(c.error)}</span>`);
+    if (c.error) parts.push(`<span class="error" id="p-error">${c.state === 'aborted' ? 'reason: ' : ''}${escapeHtml(c.error)}</span>`);
     $('#p-line').innerHTML = parts.join(' · ');
     this.renderCells(total);
   }
 
   renderCells(total) {
     const c = this.current;
-    const byIndex = new Map((c.points || []).map((p) => [p.point_index, p]));
-    const exp = c.expanded;
-    const n = Math.min(total || 0, 5000);
-    const active = ACTIVE.includes(c.state) && c.state !== 'paused';
-    let firstMissing = -1;
-    if (active && exp) for (let i = 0; i < n; i++) if (!byIndex.has(i)) { firstMissing = i; break; }
-    const host = $('#p-cells');
-    if (host.childElementCount !== n) host.innerHTML = Array.from({ length: n }, (_, i) => `<span class="c" data-i="${i}"></span>`).join('');
-    const cells = host.children;
-    for (let i = 0; i < n; i++) {
-      const p = byIndex.get(i);
-      let cls = 'c pending';
-      let title;
-      const e = exp?.[i];
-      const where = e ? `${e.speed_rpm} rpm, ${e.load_Nm} N m, ${e.angle_deg}°, ${e.estimator}/${e.pwm}` : `point ${i}`;
-      if (p) {
-        cls = p.fault ? 'c bad' : p.unstable || p.voltage_limited ? 'c warn' : 'c done';
-        title = `#${i} ${p.speed_rpm} rpm, ${p.load_Nm} N m, ${p.angle_deg}°, ${p.estimator}/${p.pwm}: I_m ${p.im_A?.toFixed(3)} A, P_dcM ${p.pdcm_W?.toFixed(1)} W, η ${(100 * p.efficiency).toFixed(1)} %${p.fault ? `, fault ${p.fault}` : ''}${p.unstable ? ', unstable' : ''}${p.voltage_limited ? ', voltage limited' : ''}`;
-      } else if (i === firstMissing) { cls = 'c active'; title = `#${i} ${where}: measuring`; }
-      else title = `#${i} ${where}: pending`;
-      if (cells[i].className !== cls) cells[i].className = cls;
-      cells[i].title = title;
-    }
-    host.dataset.done = String((c.points || []).length);
+    const adaptive = c.meta?.plan?.mode === 'adaptive';
+    if (adaptive && !c.groups) c.groups = expandGroups(c.meta.plan);
+    this.cells.render({ id: c.id, state: c.state, error: c.error, points: c.points || [], total, expanded: c.expanded,
+      groups: adaptive ? c.groups : null, maxEvaluations: c.meta?.plan?.adaptive?.max_evaluations ?? 7 });
   }
 
   renderCharts() {
