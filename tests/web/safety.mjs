@@ -126,7 +126,7 @@ try {
   check(await until(() => page.$('#help[open]'), 2000), 'the help dialog opens with ?');
   const inDialog = [];
   for (let i = 0; i < 3; ++i) { await page.keyboard.press('Tab'); inDialog.push(await page.evaluate(() => { const e = document.activeElement; return `${e.closest('dialog')?.id}:${e.tagName === 'BUTTON' ? e.textContent.trim() : e.tagName}`; })); }
-  check(inDialog.some((t) => t === 'help:Close') && inDialog.some((t) => t.startsWith('help:E-STOP')), `Tab stays in the dialog and reaches Close and E-STOP (${inDialog.join(', ')})`);
+  check(inDialog.some((t) => t === 'help:Close') && inDialog.some((t) => t.startsWith('help:E-STOP')), `Tab in the help dialog reaches Close and E-STOP (${inDialog.join(', ')})`);
   await page.keyboard.press('Escape');
   await page.waitForTimeout(600);
   check(!(await page.$('#help[open]')), 'Esc closes the help dialog');
@@ -209,7 +209,7 @@ try {
   await page.click('#estop');
   const shown = await until(() => page.$('#estop-failed:not([hidden])'), 4000, 50);
   const took = Date.now() - t0;
-  check(shown && took < 3000, `the failed E-stop banner shows within ${took} ms`);
+  check(shown && took < 3500, `the failed E-stop banner shows within ${took} ms`);
   check((await text(page, '#estop-failed')).startsWith('E-stop NOT confirmed: the daemon did not answer. Use the hardware emergency stop.'),
     `its words (${await text(page, '#estop-failed')})`);
   check((await attr(page, '#estop-failed', 'role')) === 'alert', 'the banner is role=alert');
