@@ -218,6 +218,7 @@ void BenchRuntime::tick(double now_s) {
     // The supervisor runs its own ordered stop; ours is void.
     enabled_ = false;
     stop_.cancel();
+    zero_held_setpoints();
     return;
   }
   if (stop_.tick(now_s, supervisor_->synrm(), supervisor_->load())) {
@@ -265,6 +266,16 @@ void BenchRuntime::do_estop(double now_s, const std::string& why) {
   supervisor_->estop(now_s, why);
   enabled_ = false;
   stop_.cancel();
+  zero_held_setpoints();
+}
+
+void BenchRuntime::zero_held_setpoints() {
+  // After a stop nobody chose, the next Enable must not go straight back to the speed and load
+  // the bench ran away at: an operator sets them again. The angle is no hazard at zero speed.
+  if (setpoints_.speed_rpm == 0.0 && setpoints_.load_Nm == 0.0) return;
+  setpoints_.speed_rpm = 0.0;
+  setpoints_.load_Nm = 0.0;
+  event("setpoints", "zeroed by the trip: speed 0 rpm, load 0 Nm, angle " + drivers::format_number(setpoints_.angle_deg) + " deg");
 }
 
 std::optional<Refusal> BenchRuntime::busy_with_sweep() const {

@@ -89,7 +89,8 @@ class BenchRuntime {
   void set_setpoints(SetpointsUpdate update, Done done);
   // Position source and PWM for manual operation; refused while the drives run or a sweep runs.
   void set_mode(DriveModeUpdate update, Done done);
-  // Pre-empts everything queued; latched until reset.
+  // Pre-empts everything queued; latched until reset. The held speed and load setpoints are
+  // zeroed (as on any latched trip): Enable after the reset starts at 0 rpm, 0 N m.
   void estop(std::string why, Done done);
   // Clears the latched trip and the drives' faults; resumes the heartbeats.
   void reset(Done done);
@@ -124,6 +125,8 @@ class BenchRuntime {
   void event(const std::string& kind, const std::string& message);
   bool estop_pending() const;
   void do_estop(double now_s, const std::string& why);
+  // Speed and load setpoints held for the next enable to 0 (an E-stop, any latched trip).
+  void zero_held_setpoints();
   std::optional<Refusal> apply_setpoints();
   std::optional<Refusal> begin_disable(double now_s);
   std::optional<Refusal> busy_with_sweep() const;

@@ -78,6 +78,8 @@ void SafetySupervisor::disable_all(double now_s) {
   };
   tell("SynRM", report_->synrm);
   tell("load", report_->load);
+  // Right behind an acknowledged disable: an E-stop's own answer already says whether it took.
+  zero_setpoints();
   if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
 }
 

@@ -2,6 +2,7 @@
 #include "server/http/api_routes.hpp"
 
 #include "server/http/info_routes.hpp"
+#include "server/http/instance_id.hpp"
 
 #include "server/http/response_schemas.hpp"
 
@@ -205,11 +206,11 @@ void add_api_routes(Router& router, ApiContext ctx) {
   ControlLock* control = &ctx.control;
 
   add_info_routes(router, *bench, ctx.twin);
-  router.add(answering({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs.",
+  router.add(answering({"GET", "/api/health", Role::anyone, "Liveness: the daemon answers and its bench loop runs; instance changes when the daemon restarts.",
                         [bench, version](const Request&) {
                           const auto snap = bench->snapshot();  // the status lives as long as the snapshot
                           const auto& s = snap->status;
-                          return json_response(200, {{"status", "ok"}, {"version", version}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
+                          return json_response(200, {{"status", "ok"}, {"version", version}, {"instance", instance_id()}, {"bench_time_s", s.t_s}, {"ticks", s.ticks}});
                         }},
                        health_schema()));
   router.add({"GET", "/api/openapi.json", Role::anyone, "This API as an OpenAPI 3 document.",
@@ -248,13 +249,17 @@ void add_api_routes(Router& router, ApiContext ctx) {
          return json_response(200, control->describe());
        }}};
   for (Route& r : lock_routes) router.add(answering(std::move(r), lock_schema()));
-  router.add({"POST", "/api/bench/estop", Role::operator_,
-              "E-stop: ahead of every queued command, heartbeats stopped, both drives disabled at once (one request each), "
-              "then read back and the disable repeated every tick until both read stopped; latched until reset. Answers "
-              "once both disables were tried, with the status: supervisor.disable says per drive whether it was "
-              "acknowledged, is being repeated (and why) or is confirmed.",
+  // Every signed-in role may stop the bench (a viewer watching it run away must not have to find
+  // an operator); who pressed it, token id and role, goes into the trip, its event and the log.
+  router.add({"POST", "/api/bench/estop", Role::viewer,
+              "E-stop (any signed-in role): ahead of every queued command, heartbeats stopped, both drives disabled at "
+              "once (one request each), then read back and the disable repeated every tick until both read stopped; "
+              "the held speed and load setpoints are zeroed; latched until reset. Answers once both disables were "
+              "tried, with the status: supervisor.disable says per drive whether it was acknowledged, is being "
+              "repeated (and why) or is confirmed; the trip's detail names who pressed it.",
               AsyncHandler([bench](const Request& req, Reply reply) {
-                bench->estop("E-stop (" + (req.caller_id.empty() ? std::string("REST") : req.caller_id) + ")",
+                bench->estop("E-stop by " + (req.caller_id.empty() ? std::string("an unnamed token") : req.caller_id) + " (" +
+                                 role_name(req.caller) + ")",
                              answer(std::move(reply)));
               })});
   router.add({"POST", "/api/bench/reset", Role::operator_,

@@ -198,7 +198,8 @@ class Session : public std::enable_shared_from_this<Session> {
     } else {
       // The dashboard's files need no token: the page signs in itself.
       const auto inm = req[bhttp::field::if_none_match];
-      r = shared_->files->serve(method, target, std::string_view(inm.data(), inm.size()));
+      const auto ae = req[bhttp::field::accept_encoding];
+      r = shared_->files->serve(method, target, std::string_view(inm.data(), inm.size()), std::string_view(ae.data(), ae.size()));
     }
     respond({method, path, req.version(), keep_alive, req.method() == bhttp::verb::head}, std::move(r));
   }

@@ -87,7 +87,7 @@ synbench::Json status_schema() {
 
 synbench::Json health_schema() {
   return closed_object(
-      {{"status", {{"type", "string"}, {"enum", synbench::Json::array({"ok"})}}}, {"version", kStr}, {"bench_time_s", kNum}, {"ticks", kInt}});
+      {{"status", {{"type", "string"}, {"enum", synbench::Json::array({"ok"})}}}, {"version", kStr}, {"instance", kStr}, {"bench_time_s", kNum}, {"ticks", kInt}});
 }
 
 synbench::Json bench_config_schema() {

@@ -27,11 +27,17 @@ class StaticFiles {
   // that names no file is answered with index.html, so the dashboard's client-side routes reload.
   // Without the directory or its index.html, such requests get a page saying the dashboard is
   // not built.
-  Response serve(std::string_view method, std::string_view target, std::string_view if_none_match = {}) const;
+  // `accept_encoding` is the Accept-Encoding header: when it accepts gzip and the file has a
+  // "X.gz" beside it, that is sent with Content-Encoding: gzip (Vary: Accept-Encoding on both).
+  Response serve(std::string_view method, std::string_view target, std::string_view if_none_match = {},
+                 std::string_view accept_encoding = {}) const;
 
  private:
   std::filesystem::path root_;
 };
+
+// Whether an Accept-Encoding header accepts gzip (listed, and not with q=0).
+bool accepts_gzip(std::string_view accept_encoding);
 
 // "text/javascript; charset=utf-8" for "app.js", ...; application/octet-stream when unknown.
 std::string content_type_for(const std::filesystem::path& file);

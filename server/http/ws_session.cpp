@@ -1,6 +1,7 @@
 // One /ws session: the protocol and the bounded write queue; see ws_session.hpp, docs/api.md.
 #include "server/http/ws_session.hpp"
 
+#include "server/http/instance_id.hpp"
 #include "server/http/sign_in_log.hpp"
 
 #include <cmath>
@@ -161,7 +162,7 @@ void WsSession::handle_auth(const synbench::Json& doc) {
   token_ = token;
   if (slot_) slot_->trust(identity_->role == Role::operator_ ? Trust::operator_ : Trust::viewer);
   auth_timer_.cancel();
-  send(synbench::Json{{"type", "hello"}, {"role", role_name(identity_->role)}, {"id", identity_->id}, {"version", hub_->version()}});
+  send(synbench::Json{{"type", "hello"}, {"role", role_name(identity_->role)}, {"id", identity_->id}, {"version", hub_->version()}, {"instance", instance_id()}});
 }
 
 void WsSession::handle_subscribe(const synbench::Json& doc, bool subscribe) {

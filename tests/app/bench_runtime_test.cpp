@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <filesystem>
 #include <future>
@@ -25,6 +26,11 @@ class TwinBackend final : public BenchBackend {
   drivers::Clock& clock() override { return twin_.clock(); }
   synbench::Json describe() const override { return synbench::Json::array(); }
   const BenchDescription& description() const override { return description_; }
+  // Set from the test thread, acted on by the bench thread (the one owner of the twin).
+  std::atomic<double> heat_winding_to_C{0.0};
+  void tick(double) override {
+    if (const double t = heat_winding_to_C.exchange(0.0); t > 0.0) twin_.twin().set_winding_temp_C(t);
+  }
 
  private:
   emulator::TwinBench twin_;
@@ -105,6 +111,60 @@ TEST(BenchRuntime, ACommandIsAnsweredAfterTheBenchActedAndEveryOneAtTheShutdown)
   ASSERT_TRUE(s.synrm);
   EXPECT_FALSE(drivers::running(s.synrm->state)) << "the shutdown ends with the drives read back disabled";
   EXPECT_FALSE(s.alarm);
+}
+
+// An E-stop zeroes the held speed and load setpoints (the angle stays): its own answer says so,
+// the drives' setpoints were written to 0 behind the disables, and Enable after the reset starts
+// at 0 rpm instead of going straight back to where the bench was stopped. A latched trip (here the
+// winding's temperature) does the same.
+TEST(BenchRuntime, AnEstopOrATripZeroesTheHeldSetpoints) {
+  auto owned = std::make_unique<TwinBackend>();
+  TwinBackend* backend = owned.get();
+  BenchRuntime rt(std::move(owned));
+  rt.start();
+  const auto run = [&](const std::function<void(BenchRuntime::Done)>& cmd) {
+    std::promise<Outcome> p;
+    cmd([&p](Outcome o) { p.set_value(std::move(o)); });
+    auto f = p.get_future();
+    EXPECT_EQ(f.wait_for(std::chrono::seconds(5)), std::future_status::ready);
+    return f.get();
+  };
+  ASSERT_FALSE(run([&](auto d) { rt.set_setpoints({900.0, 2.0, 55.0}, d); }).refusal);
+  ASSERT_FALSE(run([&](auto d) { rt.enable(true, d); }).refusal);
+  ASSERT_TRUE(wait_for([&] { return rt.snapshot()->status.synrm && rt.snapshot()->status.synrm->speed_rpm > 100.0; }, 5.0));
+
+  const Outcome e = run([&](auto d) { rt.estop("E-stop by test (viewer)", d); });
+  ASSERT_FALSE(e.refusal);
+  const auto& st = e.snapshot->status;
+  EXPECT_EQ(st.setpoints.speed_rpm, 0.0) << "the E-stop's own answer shows the zeroed setpoints";
+  EXPECT_EQ(st.setpoints.load_Nm, 0.0);
+  EXPECT_EQ(st.setpoints.angle_deg, 55.0) << "the angle is kept";
+  ASSERT_TRUE(st.disable);
+  EXPECT_TRUE(st.disable->synrm.setpoint_zeroed) << "written behind the acknowledged disable, before the answer";
+  EXPECT_TRUE(st.disable->load.setpoint_zeroed);
+  ASSERT_TRUE(st.trip);
+  EXPECT_EQ(st.trip->detail, "E-stop by test (viewer)");
+  bool told = false;
+  for (const auto& ev : st.events) told = told || (ev.kind == "setpoints" && ev.message.find("zeroed") != std::string::npos);
+  EXPECT_TRUE(told) << "an event says the setpoints were zeroed";
+
+  ASSERT_TRUE(wait_for([&] { return !rt.snapshot()->status.synrm || !drivers::running(rt.snapshot()->status.synrm->state); }, 5.0));
+  ASSERT_TRUE(wait_for([&] { return rt.snapshot()->status.synrm && std::abs(rt.snapshot()->status.synrm->speed_rpm) < 5.0; }, 10.0));
+  ASSERT_FALSE(run([&](auto d) { rt.reset(d); }).refusal);
+  const Outcome en = run([&](auto d) { rt.enable(true, d); });
+  ASSERT_FALSE(en.refusal);
+  EXPECT_EQ(en.snapshot->status.setpoints.speed_rpm, 0.0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  ASSERT_TRUE(rt.snapshot()->status.synrm);
+  EXPECT_LT(std::abs(rt.snapshot()->status.synrm->speed_rpm), 20.0) << "Enable did not go back to 900 rpm";
+
+  // A trip that is not an E-stop: the winding over its limit while running.
+  ASSERT_FALSE(run([&](auto d) { rt.set_setpoints({600.0, 1.0, std::nullopt}, d); }).refusal);
+  backend->heat_winding_to_C = 130.0;
+  ASSERT_TRUE(wait_for([&] { return rt.snapshot()->status.trip.has_value(); }, 5.0));
+  ASSERT_TRUE(wait_for([&] { return rt.snapshot()->status.setpoints.speed_rpm == 0.0; }, 5.0));
+  EXPECT_EQ(rt.snapshot()->status.setpoints.load_Nm, 0.0);
+  rt.shutdown();
 }
 
 // The twin's drives, whose reads take `slow_read_s` of wall time each once a disable was sent:

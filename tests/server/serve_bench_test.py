@@ -20,7 +20,8 @@ time by design). For each link:
     back at zero torque, trips its watchdog (nothing sends heartbeats), or the daemon disables
     it again;
  7. reset: 200, both drives' latched faults cleared (state disabled, fault_code none);
- 8. enable again: the drives run, the shaft turns at the setpoint;
+ 8. enable again: the E-stop zeroed the held setpoints, set again; the drives run, the shaft
+    turns at the setpoint;
  9. SIGTERM: the daemon exits 0 and both drives read disabled, and stay so past the watchdog.
 The E-stop's answer says per drive that the disable was acknowledged (supervisor.disable), the
 status then says confirmed, and the setpoint registers read zero after it. Then `cut`: an E-stop
@@ -279,7 +280,12 @@ def run_link(kind, tmp):
               "%s: reset has cleared the drives' latched faults when its reply arrives (before: %s; after: %s)"
               % (kind, fs.describe(faults_before), fs.describe(now)))
 
-        # 8. Enable again (from disabled: a drive that never stopped proves nothing here).
+        # 8. Enable again (from disabled: a drive that never stopped proves nothing here). The
+        # E-stop zeroed the held speed and load setpoints: they are set again first.
+        check(isinstance(body, dict) and body["setpoints"]["speed_rpm"] == 0 and body["setpoints"]["load_Nm"] == 0,
+              "%s: after the E-stop and the reset the held setpoints are 0 (%s)" % (kind, isinstance(body, dict) and body.get("setpoints")))
+        status, body = serve.request("POST", "/api/bench/setpoints", {"speed_rpm": SPEED})
+        check(status == 200, "%s: setpoints again after the reset -> 200 (%s)" % (kind, status))
         was_off = all(s == fs.DISABLED for s, _ in far.states())
         status, body = serve.request("POST", "/api/bench/enable", {"enabled": True})
         now = far.states()

@@ -55,6 +55,7 @@ def main():
 
         status, data, _ = d.http("GET", "/api/health")
         check(status == 200 and json.loads(data)["status"] == "ok", "health 200")
+        check(len(json.loads(data)["instance"]) == 16, "health names the daemon's instance")
 
         status, data, _ = d.http("GET", "/api/openapi.json")
         check(status == 200, "openapi 200")
@@ -73,8 +74,17 @@ def main():
                 # Validation without side effects (POST /api/sweeps/estimate): any token reads.
                 s, _, _ = d.http(method, concrete, body={})
                 check(s == 401, "%s %s without token -> 401 (got %d)" % (method, path, s))
-                s, _, _ = d.http(method, concrete, body={}, token=viewer)
+                s, data, _ = d.http(method, concrete, body={}, token=viewer)
                 check(s in (200, 400), "%s %s with viewer -> answered (got %d)" % (method, path, s))
+                if path == "/api/bench/estop":
+                    # Every signed-in role may E-stop; the trip names the viewer; an operator resets.
+                    detail = json.loads(data)["supervisor"]["trip"]["detail"]
+                    check(s == 200 and detail.startswith("E-stop by token-") and detail.endswith("(viewer)"),
+                          "a viewer's E-stop latches, naming the viewer (%s)" % detail)
+                    s, _, _ = d.http("POST", "/api/bench/reset", body={}, token=viewer)
+                    check(s == 403, "a viewer cannot reset the E-stop (got %d)" % s)
+                    s, _, _ = d.http("POST", "/api/bench/reset", body={}, token=op)
+                    check(s == 200, "an operator resets the viewer's E-stop (got %d)" % s)
             elif method != "GET":
                 check(role == "operator", "%s %s needs operator" % (method, path))
                 s, data, r = d.http(method, concrete, body={})

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """`synbench serve`'s WebSocket /ws and the dashboard's static files, over real sockets on
 loopback: the Host and Origin checks on the upgrade, auth (1008 on a bad, missing or late
-token), roles through `request` (viewer 403, operator E-stop stops the bench), telemetry pacing
+token), roles through `request` (a viewer 403 on reset and enable; its E-stop, as an operator's, stops the bench), telemetry pacing
 (20, 50 and the default 10 Hz: the messages' mean spacing in bench time), the protocol's errors (bad_message naming the field, connection kept),
 oversized messages (1009), events and state pushes; static files: index, content types, caching,
 HEAD, ETag, traversal attempts and symlinks out (never a file outside the directory), and the
@@ -10,6 +10,7 @@ HEAD, ETag, traversal attempts and symlinks out (never a file outside the direct
 usage: ws_test.py path/to/synbench
 """
 import http.client
+import gzip
 import json
 import os
 import socket
@@ -128,6 +129,9 @@ def test_auth(d, viewer):
     ws, hello = connect(d, viewer)
     check(hello["type"] == "hello" and hello["role"] == "viewer" and hello["id"].startswith("token-") and hello["version"],
           "viewer auth -> hello with role, id, version (%s)" % hello)
+    _, _, health = http_get(d, "/api/health")
+    check(len(hello.get("instance", "")) == 16 and hello["instance"] == json.loads(health)["instance"],
+          "hello carries the daemon's instance id, as GET /api/health does (%s)" % hello.get("instance"))
     check(viewer not in json.dumps(hello), "hello does not echo the token")
     ws.send(json.dumps({"op": "subscribe", "channel": "telemetry", "rate_hz": 20}))
     m = recv_until(ws, lambda m: m["type"] == "telemetry")
@@ -135,10 +139,13 @@ def test_auth(d, viewer):
     keys = {"t_s", "enabled", "phase", "speed_rpm", "torque_Nm", "im_A", "id_A", "iq_A", "udc_V", "pac_W", "temp_C",
             "pos_err_deg", "voltage_limited", "fault", "sent_unix_ms"}
     check(m and keys <= set(m), "telemetry has every field (missing %s)" % (keys - set(m or {})))
-    ws.send(json.dumps({"op": "request", "id": "e1", "method": "POST", "path": "/api/bench/estop"}))
+    ws.send(json.dumps({"op": "request", "id": "e1", "method": "POST", "path": "/api/bench/reset"}))
     r = recv_until(ws, lambda m: m["type"] == "reply")
     check(r and r["id"] == "e1" and r["status"] == 403 and r["body"]["error"]["code"] == "forbidden",
-          "viewer request POST /api/bench/estop -> reply status 403 (%s)" % r)
+          "viewer request POST /api/bench/reset -> reply status 403 (%s)" % r)
+    ws.send(json.dumps({"op": "request", "id": "e2", "method": "POST", "path": "/api/bench/enable", "body": {"enabled": True}}))
+    r = recv_until(ws, lambda m: m["type"] == "reply")
+    check(r and r["id"] == "e2" and r["status"] == 403, "viewer request POST /api/bench/enable -> reply status 403 (%s)" % r)
     ws.send(json.dumps({"op": "request", "id": {"n": [1]}, "method": "GET", "path": "/api/bench/status"}))
     r = recv_until(ws, lambda m: m["type"] == "reply")
     check(r and r["id"] == {"n": [1]} and r["status"] == 200 and r["body"]["supervisor"]["tripped"] is False,
@@ -276,6 +283,19 @@ def test_operator(d, viewer):
     ws.send(json.dumps({"op": "request", "id": "r", "method": "POST", "path": "/api/bench/reset"}))
     r = recv_until(ws, lambda m: m["type"] == "reply" and m["id"] == "r")
     check(r and r["status"] in (200, 409), "reset over WS answers (%s)" % (r and r["status"]))
+    reset_ok = r and r["status"] == 200
+    # A viewer may E-stop over the socket too (every signed-in role may), and is named in the trip.
+    vws, vhello = connect(d, viewer)
+    vws.send(json.dumps({"op": "request", "id": "vstop", "method": "POST", "path": "/api/bench/estop"}))
+    r = recv_until(vws, lambda m: m["type"] == "reply" and m["id"] == "vstop")
+    check(r and r["status"] == 200 and r["body"]["supervisor"]["phase"] == "estopped",
+          "viewer E-stop over WS -> 200, estopped (%s)" % (r and r["status"]))
+    detail = r and (r["body"]["supervisor"].get("trip") or {}).get("detail", "")
+    if reset_ok:
+        check(detail == "E-stop by %s (viewer)" % vhello["id"], "the trip names the viewer who pressed it (%s)" % detail)
+    vws.close()
+    ws.send(json.dumps({"op": "request", "id": "r2", "method": "POST", "path": "/api/bench/reset"}))
+    recv_until(ws, lambda m: m["type"] == "reply" and m["id"] == "r2")
     ws.close()
     watcher.close()
 
@@ -298,6 +318,13 @@ def test_static(d, web):
         check(s == 200 and r.getheader("Content-Type", "").startswith(ctype), "%s -> %s" % (path, ctype))
     s, r, _ = http_get(d, "/favicon.svg")
     check(r.getheader("Cache-Control") == "no-cache", "files outside assets/ are revalidated")
+    # The build's gzip beside a file: sent to a client that accepts gzip, the plain file otherwise.
+    s, r, body = http_get(d, "/assets/app-1a2b3c.js", headers={"Accept-Encoding": "gzip, deflate"})
+    check(s == 200 and r.getheader("Content-Encoding") == "gzip" and r.getheader("Vary") == "Accept-Encoding"
+          and gzip.decompress(body) == b"console.log(1)\n", "Accept-Encoding gzip -> the .gz, Content-Encoding gzip, Vary")
+    s, r, body = http_get(d, "/assets/app-1a2b3c.js", headers={"Accept-Encoding": "identity"})
+    check(s == 200 and r.getheader("Content-Encoding") is None and r.getheader("Vary") == "Accept-Encoding"
+          and body == b"console.log(1)\n", "no gzip accepted -> the plain file, Vary")
     s, r, body = http_get(d, "/assets/app-1a2b3c.js", method="HEAD")
     check(s == 200 and body == b"" and int(r.getheader("Content-Length")) > 0, "HEAD: no body, Content-Length of GET")
     s, _, body = http_get(d, "/sweeps/3")
@@ -335,6 +362,8 @@ def make_web(tmp):
             f.write(text)
     with open(os.path.join(tmp, "secret.txt"), "w") as f:
         f.write("TOP-SECRET-OUTSIDE\n")
+    with open(os.path.join(web, "assets/app-1a2b3c.js.gz"), "wb") as f:
+        f.write(gzip.compress(b"console.log(1)\n"))
     os.symlink(os.path.join(tmp, "secret.txt"), os.path.join(web, "link-out.txt"))
     os.symlink(tmp, os.path.join(web, "link-dir"))
     os.symlink("inside.txt", os.path.join(web, "link-in.txt"))

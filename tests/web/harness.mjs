@@ -88,8 +88,8 @@ export async function shot(page, artifacts, name) {
 // ---- the daemon -----------------------------------------------------------------------------
 export function tmpDir(prefix) { return fs.mkdtempSync(path.join(os.tmpdir(), prefix)); }
 
-export async function startDaemon(bin, dataDir, { port = 0, webDir } = {}) {
-  const argv = ['serve', '--listen', `127.0.0.1:${port}`, '--data-dir', dataDir];
+export async function startDaemon(bin, dataDir, { port = 0, webDir, extraArgs = [] } = {}) {
+  const argv = ['serve', '--listen', `127.0.0.1:${port}`, '--data-dir', dataDir, ...extraArgs];
   if (webDir && (await helpMentions(bin, '--web-dir'))) argv.push('--web-dir', path.join(webDir, 'dist'));
   const proc = spawn(bin, argv, { stdio: ['ignore', 'pipe', 'pipe'] });
   let stderr = '';

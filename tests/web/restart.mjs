@@ -2,7 +2,9 @@
 // stopped with SIGTERM (it aborts the sweep, keeping its points); the page shows it offline; the
 // daemon restarts on the same port and data dir, and the page reconnects by itself (indicator back
 // to connected, no new sign-in) and shows the restored state: the sweep aborted with its stored
-// points in the progress panel and the history, the bench disabled, telemetry flowing. The sweep
+// points in the progress panel and the history, the bench disabled, telemetry flowing; the new
+// daemon instance is noticed and the old daemon's events are cleared, with one line "daemon
+// restarted" (GET /api/health and the hello carry the instance id). The sweep
 // is then continued from the page to completion; a reload keeps the session.
 // Screenshots: ARTIFACT_DIR/restart-*.png.
 //
@@ -43,6 +45,9 @@ try {
   check(await until(async () => Number(await attr(page, '#p-cells', 'data-done')) >= 2, 30000), 'the sweep runs: 2 points measured');
   await shot(page, artifacts, 'restart-1-running');
 
+  const oldInstance = await page.evaluate(() => window.synbench.instance);
+  const oldEvents = await page.$$eval('#events li', (lis) => lis.map((li) => li.textContent.trim()));
+  check(oldInstance && oldEvents.length > 0, `before the restart: instance ${oldInstance}, ${oldEvents.length} events shown`);
   const code = await stopDaemon(daemon);
   check(code === 0, `SIGTERM: the daemon exits 0 (${code})`);
   const stopped = await rest(daemon.url, 'GET', '/').catch(() => null);
@@ -63,6 +68,14 @@ try {
   check(await until(async () => (await text(page, '#p-state')) === 'aborted', 10000), `the progress panel shows the sweep aborted (${await text(page, '#p-state')})`);
   check(await until(async () => Number(await attr(page, '#p-cells', 'data-done')) === meta.points_stored, 10000), 'its stored points are shown');
   check(await until(async () => (await text(page, '#bench-pill')) === 'bench disabled', 10000), `the bench state is restored (${await text(page, '#bench-pill')})`);
+  // The new daemon is noticed (its instance id) and the old one's events are gone, with one line.
+  check(await until(async () => (await page.evaluate(() => window.synbench.instance)) !== oldInstance, 10000),
+    `the page notices the new daemon instance (${await page.evaluate(() => window.synbench.instance)})`);
+  check(await until(async () => (await text(page, '#events')).includes('daemon restarted'), 10000), 'the events panel says "daemon restarted"');
+  const newEvents = await page.$$eval('#events li', (lis) => lis.map((li) => li.textContent.trim()));
+  const stale = newEvents.filter((e) => oldEvents.includes(e));
+  check(stale.length === 0 && newEvents.filter((e) => e.includes('daemon restarted')).length === 1,
+    `none of the old daemon's events is shown, one restart line (${stale.join('; ') || newEvents.length + ' lines'})`);
   await shot(page, artifacts, 'restart-3-reconnected');
   await page.keyboard.press('1');
   const tBefore = await page.evaluate(() => window.synbench.status?.t_s);

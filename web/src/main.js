@@ -1,5 +1,6 @@
 // synbench dashboard: sign-in, the live link, routing between the four views, the always-visible
-// E-stop and the keyboard shortcuts. State shared by the views lives in `app`.
+// E-stop (any signed-in role; a loud banner when the daemon does not confirm it) and the keyboard
+// shortcuts. State shared by the views lives in `app`.
 import './style.css';
 import { api, setToken, setUnauthorizedHandler, ApiError } from './api.js';
 import { Link, faultText } from './link.js';
@@ -20,6 +21,7 @@ class App {
     this.listeners = new Map();
     this.link = null;
     this.view = 'live';
+    this.instance = null;        // the daemon's per-start id (GET /api/health, the socket's hello)
   }
 
   on(ev, fn) { (this.listeners.get(ev) || this.listeners.set(ev, []).get(ev)).push(fn); }
@@ -53,6 +55,15 @@ class App {
     this.status = st;
     this.emit('status', st);
     renderBenchPills(st);
+    // A failed E-stop's banner stays until the daemon itself says the bench is stopped.
+    if (st.supervisor?.phase === 'estopped' && !st.enabled) $('#estop-failed').hidden = true;
+  }
+
+  // A new daemon instance (a restart): what the page showed of the old one's events goes.
+  noteInstance(id) {
+    if (!id) return;
+    if (this.instance && id !== this.instance) this.emit('daemon-restarted', id);
+    this.instance = id;
   }
 
   async refreshSweeps() {
@@ -76,7 +87,7 @@ window.synbench = app; // for the end-to-end tests and the console
 function renderConn(state) {
   const el = $('#conn');
   el.dataset.state = state;
-  el.textContent = { connected: 'connected', polling: 'connected (REST polling)', connecting: 'connecting…', offline: 'offline, reconnecting…' }[state] || state;
+  el.textContent = { connected: 'connected', polling: 'connected (REST polling)', connecting: 'connecting…', offline: 'offline, reconnecting…', signedout: 'signed out' }[state] || state;
   document.body.dataset.conn = state;
   if (state === 'offline') {
     const b = $('#bench-pill');
@@ -127,12 +138,17 @@ function renderRole() {
   r.dataset.state = app.role || 'none';
   r.textContent = app.role === 'operator' ? 'operator' : app.role === 'viewer' ? 'viewer · read-only' : 'signed out';
   r.title = app.role ? `${app.role}${app.callerId ? ` (${app.callerId})` : ''}` : 'Not signed in';
+  r.hidden = !app.role; // signed out: the connection pill says so once
+  $('#signout').hidden = !app.role;
   document.body.classList.toggle('role-viewer', app.role === 'viewer');
   document.body.classList.toggle('role-operator', app.role === 'operator');
-  for (const el of document.querySelectorAll('.operator-only button, .operator-only input, .operator-only select, #estop'))
+  for (const el of document.querySelectorAll('.operator-only button, .operator-only input, .operator-only select'))
     el.disabled = app.role !== 'operator';
-  $('#estop').title = app.role === 'operator' ? 'Emergency stop: both drives disabled at once, latched until reset (key: Esc)'
-    : 'E-stop needs an operator token (you are signed in as a viewer)';
+  // Every signed-in role may E-stop (the daemon records who did); only operators command.
+  for (const el of document.querySelectorAll('.estop')) {
+    el.disabled = !app.role;
+    el.title = app.role ? 'Emergency stop: both drives disabled at once, latched until reset (key: Esc)' : 'E-stop needs a sign-in';
+  }
   app.emit('role', app.role);
 }
 
@@ -161,6 +177,7 @@ function storedToken() { return sessionStorage.getItem(TOKEN_KEY) || localStorag
 async function signIn(token, remember) {
   setToken(token);
   const me = await whoami();
+  noteHealth();
   app.role = me.role;
   app.callerId = me.id;
   sessionStorage.setItem(TOKEN_KEY, token);
@@ -184,6 +201,7 @@ function signOut() {
   app.role = null;
   if (app.link) app.link.stop();
   app.link = null;
+  renderConn('signedout');
   renderRole();
   showSignIn();
 }
@@ -199,11 +217,16 @@ function startLink() {
       app.emit('sweep-progress', s);
     },
     event: (e) => app.emit('event', e),
-    hello: (h) => { if (h.role && h.role !== app.role) { app.role = h.role; renderRole(); } if (h.id) app.callerId = h.id; },
+    hello: (h) => { if (h.role && h.role !== app.role) { app.role = h.role; renderRole(); } if (h.id) app.callerId = h.id; app.noteInstance(h.instance); },
     unauthorized: () => showSignIn('The daemon no longer accepts this token.'),
-    restored: () => { whoami().then((me) => { app.role = me.role; app.callerId = me.id; renderRole(); }).catch(() => {}); app.refreshAll(); app.toast('Reconnected to the daemon'); },
+    restored: () => { noteHealth(); whoami().then((me) => { app.role = me.role; app.callerId = me.id; renderRole(); }).catch(() => {}); app.refreshAll(); app.toast('Reconnected to the daemon'); },
   });
   app.link.start();
+}
+
+// The daemon's instance id: a restart is noticed on the first answer of the new daemon.
+function noteHealth() {
+  api('GET', '/api/health', undefined, { quiet401: true, timeoutMs: 3000 }).then((h) => app.noteInstance(h?.instance)).catch(() => {});
 }
 
 // The socket pushes a state message only when enabled/phase/trip change: setpoints, the sweep
@@ -226,25 +249,44 @@ function route() {
   app.emit('view', { view, arg: m?.[2] ? Number(m[2]) : null });
 }
 
+// An E-stop the daemon did not confirm within this: the page says so loudly, at once.
+const ESTOP_TIMEOUT_MS = 1500;
+
 async function estop() {
-  if (!app.link || !app.isOperator) { app.toast('E-stop needs an operator token', true); return; }
+  if (!app.role) { app.toast('E-stop needs a sign-in', true); return; }
   $('#estop').classList.add('pressed');
   // REST and the socket at once: the first to arrive stops the bench, the second is a no-op.
-  const rest = api('POST', '/api/bench/estop', {}).then((st) => { app.setStatus(st); return st; });
-  const viaWs = app.link.state === 'connected' ? app.link.request('POST', '/api/bench/estop', {}) : Promise.reject(new Error('no socket'));
+  const rest = api('POST', '/api/bench/estop', {}, { timeoutMs: ESTOP_TIMEOUT_MS }).then((st) => { app.setStatus(st); return st; });
+  const viaWs = app.link && app.link.state === 'connected' ? app.link.request('POST', '/api/bench/estop', {}) : Promise.reject(new Error('no socket'));
+  let timer;
+  const late = new Promise((_, reject) => { timer = setTimeout(() => reject(new Error('no answer')), ESTOP_TIMEOUT_MS); });
   try {
-    await Promise.any([rest, viaWs]);
+    const st = await Promise.race([Promise.any([rest, viaWs]), late]);
+    if (st?.supervisor) app.setStatus(st);
+    $('#estop-failed').hidden = true;
     app.toast('E-STOP: both drives disabled (reset to clear)');
   } catch (e) {
-    app.toast(`E-stop failed: ${e.errors?.[0]?.message || e.message}`, true);
+    const why = e.errors?.[0]?.message || e.message;
+    // Not a toast: it stays until a status read shows the bench stopped, or it is dismissed.
+    $('#estop-failed-why').textContent = why ? `(${why})` : '';
+    $('#estop-failed').hidden = false;
+  } finally {
+    clearTimeout(timer);
   }
+}
+
+function openHelp() {
+  if (!$('#help').open) $('#help').showModal();
 }
 
 document.addEventListener('keydown', (e) => {
   if (e.key === 'Escape') {
-    // Esc is the E-stop everywhere, also in fields and dialogs (except the sign-in dialog).
-    if ($('#signin').open) return;
+    // Esc is the E-stop everywhere, also in fields; in the help dialog it closes the dialog (what
+    // Esc does in every dialog; the dialog's own E-STOP button is there), and in the sign-in
+    // dialog it does nothing (no token to stop with yet).
     e.preventDefault();
+    if ($('#signin').open) return;
+    if ($('#help').open) { $('#help').close(); return; }
     estop();
     return;
   }
@@ -252,14 +294,16 @@ document.addEventListener('keydown', (e) => {
   const typing = t && (t.isContentEditable || ['INPUT', 'SELECT', 'TEXTAREA'].includes(t.tagName));
   if (typing || e.ctrlKey || e.metaKey || e.altKey || document.querySelector('dialog[open]')) return;
   if (/^[1-4]$/.test(e.key)) { location.hash = `#/${VIEWS[Number(e.key) - 1]}`; e.preventDefault(); }
-  else if (e.key === '?') { $('#help').showModal(); e.preventDefault(); }
+  else if (e.key === '?') { openHelp(); e.preventDefault(); }
 });
 
 // ---- start ------------------------------------------------------------------------------------
 function init() {
-  renderConn('offline');
+  renderConn('signedout');
   renderRole();
-  $('#estop').addEventListener('click', estop);
+  for (const b of document.querySelectorAll('.estop')) b.addEventListener('click', estop);
+  $('#estop-failed-dismiss').addEventListener('click', () => { $('#estop-failed').hidden = true; });
+  $('#help-open').addEventListener('click', openHelp);
   $('#signout').addEventListener('click', signOut);
   $('#help').addEventListener('cancel', (e) => e.preventDefault());
   $('#signin').addEventListener('cancel', (e) => e.preventDefault());
@@ -274,6 +318,7 @@ function init() {
       app.toast(`Signed in as ${app.role}`);
     } catch (err) {
       $('#signin-error').textContent = err instanceof ApiError && err.status === 401 ? 'Unknown token.' : `Cannot sign in: ${err.message}`;
+      if (err.status === 0) renderConn('offline'); // a sign-in was tried: now "unreachable" is news
     } finally {
       $('#signin-submit').disabled = false;
     }

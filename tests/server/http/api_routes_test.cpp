@@ -42,13 +42,31 @@ struct Api : ::testing::Test {
   Router router;
 };
 
+// ... but the E-stop, which every signed-in role may press (and which names who did).
 TEST_F(Api, EveryMutatingRouteNeedsAnOperator) {
   for (const auto& r : router.routes()) {
-    if (r.method == "GET") continue;
+    if (r.method == "GET" || r.pattern == "/api/bench/estop") continue;
     EXPECT_EQ(r.role, Role::operator_) << r.pattern;
     EXPECT_EQ(router.dispatch(r.method, r.pattern, "", "{}").status, 401) << r.pattern;
     EXPECT_EQ(router.dispatch(r.method, r.pattern, "Bearer view", "{}").status, 403) << r.pattern;
   }
+}
+
+TEST_F(Api, AViewerMayEstopButNotResetOrEnable) {
+  EXPECT_EQ(post("/api/bench/estop", "", "").status, 401);
+  const auto e = post("/api/bench/estop", "", "view");
+  ASSERT_EQ(e.status, 200) << e.body;
+  const auto s = synbench::Json::parse(e.body);
+  EXPECT_EQ(s["supervisor"]["phase"], "estopped");
+  EXPECT_EQ(s["supervisor"]["trip"]["detail"], "E-stop by view (viewer)");
+  bool named = false;
+  for (const auto& ev : s["events"]) named = named || ev["message"].get<std::string>().find("E-stop by view (viewer)") != std::string::npos;
+  EXPECT_TRUE(named) << "the event names who pressed it";
+  EXPECT_EQ(post("/api/bench/reset", "", "view").status, 403);
+  EXPECT_EQ(post("/api/bench/enable", R"({"enabled": true})", "view").status, 403);
+  EXPECT_EQ(post("/api/bench/setpoints", R"({"speed_rpm": 100})", "view").status, 403);
+  const auto o = synbench::Json::parse(post("/api/bench/estop", "", "op").body);
+  EXPECT_EQ(o["supervisor"]["trip"]["detail"], "E-stop by view (viewer)") << "latched: the first press is the trip";
 }
 
 TEST_F(Api, SetpointsAreValidatedNamingTheField) {

@@ -84,6 +84,32 @@ TEST_F(Static, MissingDirectoryGivesTheNotBuiltPage) {
   EXPECT_NE(StaticFiles(base / "web").serve("GET", "/").body.find("not built"), std::string::npos);
 }
 
+// The build's "X.gz" beside a file: sent with Content-Encoding gzip to a client that accepts gzip,
+// the plain file otherwise; Vary: Accept-Encoding on both answers; a file without one is plain.
+TEST_F(Static, ServesTheGzipOfAFileToAClientThatAcceptsIt) {
+  write(base / "web" / "assets" / "app-1f2e.js.gz", "GZ-BYTES");
+  StaticFiles files(base / "web");
+  auto r = files.serve("GET", "/assets/app-1f2e.js", "", "gzip, deflate, br");
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.body, "GZ-BYTES");
+  EXPECT_EQ(header(r, "Content-Encoding"), "gzip");
+  EXPECT_EQ(header(r, "Vary"), "Accept-Encoding");
+  EXPECT_EQ(r.content_type, "text/javascript; charset=utf-8") << "the type of what it decodes to";
+  const std::string gz_etag = header(r, "ETag");
+  for (const char* ae : {"", "identity", "br", "gzip;q=0", "deflate, gzip; q=0.0"}) {
+    r = files.serve("GET", "/assets/app-1f2e.js", "", ae);
+    EXPECT_EQ(r.body, "console.log(1)") << ae;
+    EXPECT_EQ(header(r, "Content-Encoding"), "") << ae;
+    EXPECT_EQ(header(r, "Vary"), "Accept-Encoding") << ae;
+    EXPECT_NE(header(r, "ETag"), gz_etag) << "two representations, two ETags";
+  }
+  EXPECT_EQ(files.serve("GET", "/assets/app-1f2e.js", "", "GZIP;q=0.8").body, "GZ-BYTES");
+  r = files.serve("GET", "/logo.svg", "", "gzip");
+  EXPECT_EQ(r.body, "<svg/>");
+  EXPECT_EQ(header(r, "Content-Encoding"), "");
+  EXPECT_EQ(header(r, "Vary"), "");
+}
+
 TEST(ContentType, ByExtension) {
   EXPECT_EQ(content_type_for("a.CSS"), "text/css; charset=utf-8");
   EXPECT_EQ(content_type_for("a.woff2"), "font/woff2");

@@ -60,6 +60,8 @@ export class LiveView {
     app.on('status', (st) => this.onStatus(st));
     app.on('sweep-progress', () => { if (app.status) { this.feed.update(app.status); this.renderReadout(); } });
     app.on('event', (e) => this.addEvents([e]));
+    // A new daemon instance: the old one's events are not this one's (one line says why they went).
+    app.on('daemon-restarted', () => { this.events = []; this.restartNote = true; this.renderEvents(); });
     app.on('view', ({ view }) => { this.visible = view === 'live'; if (this.visible) this.dirty = true; });
     app.on('refresh', () => { this.refreshLock(); this.fillHistory(); if (!this.estimatorsFromDaemon) this.fillEstimators(true); });
     // Long spans redraw once a second: 15 min are 18000 samples a series.
@@ -225,7 +227,12 @@ export class LiveView {
     this.renderReadout();
     this.feed.update(st);
     const f = $('#setpoints-form');
-    if (!this.spEdited && !f.contains(document.activeElement) && st.setpoints) {
+    // A new trip zeroed the daemon's setpoints: the form shows that, whatever was being typed
+    // (judged on full statuses only: the socket's state pushes carry no setpoints).
+    const newTrip = !!st.setpoints && !!st.supervisor?.trip && !this.tripSeen;
+    if (st.setpoints) this.tripSeen = !!st.supervisor?.trip;
+    if (newTrip) this.spEdited = false;
+    if (st.setpoints && (newTrip || (!this.spEdited && !f.contains(document.activeElement)))) {
       f.speed_rpm.value = st.setpoints.speed_rpm;
       f.load_Nm.value = st.setpoints.load_Nm;
       f.angle_deg.value = st.setpoints.angle_deg;
@@ -282,7 +289,8 @@ export class LiveView {
 
   renderEvents() {
     $('#events').innerHTML = this.events.slice().reverse()
-      .map((e) => `<li><b>${fmt(e.t_s, 1)} s ${escapeHtml(e.kind)}</b>${escapeHtml(e.message)}</li>`).join('');
+      .map((e) => `<li><b>${fmt(e.t_s, 1)} s ${escapeHtml(e.kind)}</b>${escapeHtml(e.message)}</li>`).join('')
+      + (this.restartNote ? '<li class="restart-note"><b>link</b>daemon restarted</li>' : '');
   }
 
   async refreshLock() {
