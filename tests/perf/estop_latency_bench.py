@@ -88,10 +88,6 @@ class Bench:
                             log_path=os.path.join(tmp, kind + "_serve.log"), start_timeout_s=SLOW_S)
         self.viewer = self.serve.token("viewer")
         self.latched = False  # an E-stop was sent since the last successful reset
-        status, body = self.serve.request("POST", "/api/bench/setpoints",
-                                          {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
-        if status != 200:
-            print("  %s: setpoints -> %s %s" % (kind, status, str(body)[:200]))
 
     def close(self):
         rc, _ = self.serve.stop()
@@ -130,6 +126,11 @@ class Bench:
             if status != 202:
                 raise TrialError("sweep start -> %s %s" % (status, str(body)[:160]))
         else:
+            # An E-stop zeroes the held speed and load: an operator sets them again before Enable.
+            status, body = self.serve.request("POST", "/api/bench/setpoints",
+                                              {"speed_rpm": SPEED, "load_Nm": LOAD_NM, "angle_deg": ANGLE})
+            if status != 200:
+                raise TrialError("setpoints -> %s %s" % (status, str(body)[:160]))
             status, body = self.serve.request("POST", "/api/bench/enable", {"enabled": True})
             if status != 200:
                 raise TrialError("enable -> %s %s" % (status, str(body)[:160]))
