@@ -2,14 +2,14 @@
 // PNG export (ECharts' getDataURL), an "no data yet" note, and data-points="N" (the number of
 // finite data values drawn) for the end-to-end tests.
 import * as echarts from 'echarts/core';
-import { LineChart, HeatmapChart, BarChart, ScatterChart } from 'echarts/charts';
+import { LineChart, HeatmapChart, BarChart, ScatterChart, CustomChart } from 'echarts/charts';
 import {
   GridComponent, TooltipComponent, LegendComponent, VisualMapComponent, TitleComponent, DataZoomComponent,
 } from 'echarts/components';
 import { CanvasRenderer } from 'echarts/renderers';
 import { saveBlob } from './api.js';
 
-echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, GridComponent, TooltipComponent, LegendComponent,
+echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, CustomChart, GridComponent, TooltipComponent, LegendComponent,
   VisualMapComponent, TitleComponent, DataZoomComponent, CanvasRenderer]);
 
 // Okabe-Ito based palette: distinguishable with colour-blindness, dark enough on white.
