@@ -4,9 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <map>
+#include <set>
 
 #include "bench/analysis.hpp"
+#include "bench/efficiency_grid.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -168,10 +169,7 @@ EfficiencyContours contours_of(const MeasuredGrid& g, const ContourOptions& opti
   return out;
 }
 
-std::vector<EfficiencyContours> efficiency_contours(const std::vector<EfficiencyCell>& cells,
-                                                    const ContourOptions& options) {
-  std::map<Configuration, std::vector<const EfficiencyCell*>> by_config;
-  for (const auto& c : cells) by_config[c.configuration].push_back(&c);
+MeasuredGrid measured_efficiency_grid(const std::vector<EfficiencyCell>& cells, const Configuration& configuration) {
   const auto add = [](std::vector<double>& v, double x) {
     for (double y : v)
       if (std::fabs(y - x) < 1e-6) return;
@@ -182,20 +180,28 @@ std::vector<EfficiencyContours> efficiency_contours(const std::vector<Efficiency
     while (std::fabs(v[i] - x) >= 1e-6) ++i;
     return i;
   };
-  std::vector<EfficiencyContours> out;
-  for (const auto& [config, list] : by_config) {
-    MeasuredGrid g;
-    for (const auto* c : list) {
-      add(g.speed_rpm, c->speed_rpm);
-      add(g.load_Nm, c->load_Nm);
+  MeasuredGrid g;
+  for (const auto& c : cells)
+    if (c.configuration == configuration) {
+      add(g.speed_rpm, c.speed_rpm);
+      add(g.load_Nm, c.load_Nm);
     }
-    std::sort(g.speed_rpm.begin(), g.speed_rpm.end());
-    std::sort(g.load_Nm.begin(), g.load_Nm.end());
-    g.values.assign(g.load_Nm.size(), std::vector<std::optional<double>>(g.speed_rpm.size()));
-    for (const auto* c : list)
-      if (c->pdcm_W > 0 && std::isfinite(c->efficiency))
-        g.values[index(g.load_Nm, c->load_Nm)][index(g.speed_rpm, c->speed_rpm)] = c->efficiency;
-    out.push_back(contours_of(g, options));
+  std::sort(g.speed_rpm.begin(), g.speed_rpm.end());
+  std::sort(g.load_Nm.begin(), g.load_Nm.end());
+  g.values.assign(g.load_Nm.size(), std::vector<std::optional<double>>(g.speed_rpm.size()));
+  for (const auto& c : cells)
+    if (c.configuration == configuration && c.pdcm_W > 0 && std::isfinite(c.efficiency))
+      g.values[index(g.load_Nm, c.load_Nm)][index(g.speed_rpm, c.speed_rpm)] = c.efficiency;
+  return g;
+}
+
+std::vector<EfficiencyContours> efficiency_contours(const std::vector<EfficiencyCell>& cells,
+                                                    const ContourOptions& options) {
+  std::set<Configuration> configs;
+  for (const auto& c : cells) configs.insert(c.configuration);
+  std::vector<EfficiencyContours> out;
+  for (const auto& config : configs) {
+    out.push_back(contours_of(measured_efficiency_grid(cells, config), options));
     out.back().configuration = config;
   }
   return out;

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "app/report/svg_plot.hpp"
+#include "bench/efficiency_grid.hpp"
 #include "db/export.hpp"
 #include "synbench/version.hpp"
 
@@ -62,19 +63,10 @@ void figures_of(Page& p, const Configuration& cfg) {
     m.x_label = "speed [rpm]";
     m.y_label = "load torque T_L [N m]";
     m.categorical = true;
-    for (const auto& e : a.efficiency)
-      if (e.configuration == cfg) {
-        if (std::none_of(m.xs.begin(), m.xs.end(), [&](double x) { return same(x, e.speed_rpm); })) m.xs.push_back(e.speed_rpm);
-        if (std::none_of(m.ys.begin(), m.ys.end(), [&](double y) { return same(y, e.load_Nm); })) m.ys.push_back(e.load_Nm);
-      }
-    std::sort(m.xs.begin(), m.xs.end());
-    std::sort(m.ys.begin(), m.ys.end());
-    m.z.assign(m.ys.size(), std::vector<std::optional<double>>(m.xs.size()));
-    for (const auto& e : a.efficiency)
-      if (e.configuration == cfg && e.pdcm_W > 0)
-        for (std::size_t r = 0; r < m.ys.size(); ++r)
-          for (std::size_t k = 0; k < m.xs.size(); ++k)
-            if (same(m.ys[r], e.load_Nm) && same(m.xs[k], e.speed_rpm)) m.z[r][k] = e.efficiency;
+    const auto grid = bench::measured_efficiency_grid(a.efficiency, cfg);
+    m.xs = grid.speed_rpm;
+    m.ys = grid.load_Nm;
+    m.z = grid.values;
     p.figure(svg_heat(m));
     HeatPlot f;
     f.title = p.title("Efficiency contours (interpolated, iso-efficiency lines)", cfg);
@@ -266,27 +258,15 @@ std::string render_report(const ReportInput& in) {
          td(shortest(c.speed_rpm)) + td(shortest(c.load_Nm)) + td(std::to_string(c.points)) + opt(c.mtpa) + opt(c.me) + "</tr>";
   b += "</tbody></table>\n";
   for (const auto& cfg : configs) {
-    std::vector<double> speeds, loads;
-    for (const auto& e : a.efficiency)
-      if (e.configuration == cfg) {
-        if (std::none_of(speeds.begin(), speeds.end(), [&](double x) { return same(x, e.speed_rpm); })) speeds.push_back(e.speed_rpm);
-        if (std::none_of(loads.begin(), loads.end(), [&](double x) { return same(x, e.load_Nm); })) loads.push_back(e.load_Nm);
-      }
-    std::sort(speeds.begin(), speeds.end());
-    std::sort(loads.begin(), loads.end());
+    const auto grid = bench::measured_efficiency_grid(a.efficiency, cfg);
     b += "<h3>Efficiency at the ME angle, speed x load, " + escape_xml(label(cfg)) + "</h3>\n<table class=\"eta-grid\" data-estimator=\"" +
          std::string(drivers::name(cfg.estimator)) + "\" data-pwm=\"" + std::string(drivers::name(cfg.pwm)) +
          "\"><thead><tr><th>speed_rpm \\ load_Nm</th>";
-    for (double l : loads) b += "<th>" + shortest(l) + "</th>";
+    for (double l : grid.load_Nm) b += "<th>" + shortest(l) + "</th>";
     b += "</tr></thead><tbody>";
-    for (double sp : speeds) {
-      b += "<tr><th>" + shortest(sp) + "</th>";
-      for (double l : loads) {
-        std::string v = "–";
-        for (const auto& e : a.efficiency)
-          if (e.configuration == cfg && same(e.speed_rpm, sp) && same(e.load_Nm, l) && e.pdcm_W > 0) v = fixed(e.efficiency, 4);
-        b += td(v);
-      }
+    for (std::size_t k = 0; k < grid.speed_rpm.size(); ++k) {  // rows: speed, as the analysis' efficiency_map
+      b += "<tr><th>" + shortest(grid.speed_rpm[k]) + "</th>";
+      for (std::size_t r = 0; r < grid.load_Nm.size(); ++r) b += td(grid.values[r][k] ? fixed(*grid.values[r][k], 4) : "–");
       b += "</tr>";
     }
     b += "</tbody></table>\n";
