@@ -206,6 +206,7 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
   for (const auto& c : a.curves)
     a.efficiency.push_back({c.configuration, c.speed_rpm, c.load_Nm, c.me.angle_deg, c.me.pm_W, c.me.pdcm_W,
                             c.me.efficiency, c.me.refined});
+  a.efficiency_contours = efficiency_contours(a.efficiency, options.contours);
   return a;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/efficiency_contours.hpp"
 #include "bench/point_record.hpp"
 #include "bench/sweep_plan_configuration.hpp"
 
@@ -32,6 +33,8 @@ struct AnalysisOptions {
   double ld_err_bin_pct = 5.0;
   double lq_err_bin_pct = 5.0;
   double rs_err_bin_pct = 20.0;
+  // Levels and resolution of the efficiency map's iso-lines (default: "nice" steps).
+  ContourOptions contours;
 };
 
 // An optimum of one curve, with both quantities (and the shaft power) read at its angle from the
@@ -117,6 +120,7 @@ struct Analysis {
   std::vector<Histogram> histograms;         // per configuration and quantity with data
   std::vector<PositionErrorResult> position_error;  // configurations with a position error
   std::vector<EfficiencyCell> efficiency;
+  std::vector<EfficiencyContours> efficiency_contours;  // the map interpolated, with iso-lines
 };
 
 Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions& options = {});

@@ -244,6 +244,39 @@ ojson to_json(const Analysis& a) {
   }
   em["entries"] = maps;
   j["efficiency_map"] = em;
+
+  ojson ec = section(
+      "Per configuration: the efficiency map interpolated bilinearly inside the measured speed x load grid "
+      "(never outside it, and not in a cell with a corner not measured: null there), efficiency[i][j] at "
+      "load_Nm[i] and speed_rpm[j]; and its iso-efficiency lines by marching squares at levels, each line "
+      "a list of segments [[speed_rpm, load_Nm], [speed_rpm, load_Nm]].",
+      nullptr);
+  ojson ce2 = ojson::array();
+  for (const auto& c : a.efficiency_contours) {
+    ojson x = ojson::object();
+    put_configuration(x, c.configuration);
+    x["speed_rpm"] = c.speed_rpm;
+    x["load_Nm"] = c.load_Nm;
+    ojson field = ojson::array();
+    for (const auto& row : c.efficiency) {
+      ojson r = ojson::array();
+      for (const auto& v : row) r.push_back(v ? number(*v) : ojson(nullptr));
+      field.push_back(r);
+    }
+    x["efficiency"] = field;
+    x["levels"] = c.levels;
+    ojson lines = ojson::array();
+    for (const auto& l : c.lines) {
+      ojson segs = ojson::array();
+      for (const auto& s : l.segments)
+        segs.push_back(ojson::array({ojson::array({s[0][0], s[0][1]}), ojson::array({s[1][0], s[1][1]})}));
+      lines.push_back({{"level", l.level}, {"segments", segs}});
+    }
+    x["lines"] = lines;
+    ce2.push_back(x);
+  }
+  ec["entries"] = ce2;
+  j["efficiency_contours"] = ec;
   return j;
 }
 

@@ -21,6 +21,7 @@ commands:
   serve     run the daemon: REST API, WebSocket and dashboard over the twin or real drives
   bench     check a bench config and probe its devices, read its drives, clear their faults
   profile   check device profiles
+  report    write a sweep's report: one self-contained HTML file and the points CSV
   token     create a bearer token for the daemon
 
   synbench <command> --help    options of a command
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   if (command == "token") return synbench::cli::token_command(args);
   if (command == "bench") return synbench::cli::bench_command(args);
   if (command == "profile") return synbench::cli::profile_command(args);
+  if (command == "report") return synbench::cli::report_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

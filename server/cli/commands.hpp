@@ -16,6 +16,7 @@ int token_command(const std::vector<std::string>& args);
 int bench_command(const std::vector<std::string>& args);
 int bench_check_command(const std::vector<std::string>& args);  // `bench check ...`, after "check"
 int profile_command(const std::vector<std::string>& args);
+int report_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
@@ -25,5 +26,6 @@ extern const char* const kServeHelp;
 extern const char* const kTokenHelp;
 extern const char* const kBenchHelp;
 extern const char* const kProfileHelp;
+extern const char* const kReportHelp;
 
 }  // namespace synbench::cli

@@ -132,10 +132,36 @@ synbench::Json points_schema() {
             {"description", "point_index and the point record's members (docs/record.md)"}}}};
 }
 
+namespace {
+// The efficiency map interpolated, with iso-lines (bench/efficiency_contours.hpp).
+synbench::Json contours_schema() {
+  const synbench::Json point = {{"type", "array"}, {"items", kNum}, {"minItems", 2}, {"maxItems", 2}};
+  const synbench::Json entry = {
+      {"type", "object"},
+      {"required", synbench::Json::array({"estimator", "pwm", "speed_rpm", "load_Nm", "efficiency", "levels", "lines"})},
+      {"properties",
+       {{"estimator", kStr},
+        {"pwm", kStr},
+        {"speed_rpm", {{"type", "array"}, {"items", kNum}}},
+        {"load_Nm", {{"type", "array"}, {"items", kNum}}},
+        {"efficiency", {{"type", "array"}, {"items", {{"type", "array"}, {"items", nullable(kNum)}}}}},
+        {"levels", {{"type", "array"}, {"items", kNum}}},
+        {"lines",
+         {{"type", "array"},
+          {"items", closed_object({{"level", kNum},
+                                   {"segments", {{"type", "array"}, {"items", {{"type", "array"}, {"items", point}}}}}})}}}}}};
+  return {{"type", "object"},
+          {"required", synbench::Json::array({"entries"})},
+          {"properties", {{"entries", {{"type", "array"}, {"items", entry}}}}}};
+}
+}  // namespace
+
 synbench::Json analysis_schema() {
   return {{"type", "object"},
           {"required", synbench::Json::array({"schema"})},
-          {"properties", {{"schema", {{"type", "string"}, {"enum", synbench::Json::array({"synbench.analysis/1"})}}}}},
+          {"properties",
+           {{"schema", {{"type", "string"}, {"enum", synbench::Json::array({"synbench.analysis/1"})}}},
+            {"efficiency_contours", contours_schema()}}},
           {"description", "docs/analysis.md"}};
 }
 

@@ -275,7 +275,7 @@ synbench::Json Router::openapi(const std::string& title, const std::string& vers
     if (r.request_schema)
       op["requestBody"] = {{"required", true}, {"content", {{"application/json", {{"schema", *r.request_schema}}}}}};
     synbench::Json ok = {{"description", "success"}};
-    if (r.response_schema) ok["content"] = {{"application/json", {{"schema", *r.response_schema}}}};
+    if (r.response_schema) ok["content"] = {{r.response_content_type, {{"schema", *r.response_schema}}}};
     synbench::Json responses = {{"200", ok},
                                 {"default", {{"description", "error"},
                                              {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}}};

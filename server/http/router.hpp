@@ -79,6 +79,7 @@ struct Route {
   // whose body is optional (the sweep abort's reason): it checks a body only when one is given.
   bool body_checked_by_handler = false;
   std::optional<synbench::Json> response_schema;  // JSON Schema of the 200 answer, where the OpenAPI document gives one
+  std::string response_content_type = "application/json";  // of the 200 answer, for the OpenAPI document
 };
 
 // A token's role and a label naming its holder in messages and the control lock (the first

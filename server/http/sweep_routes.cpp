@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 
+#include "app/report/sweep_report.hpp"
 #include "bench/analysis.hpp"
 #include "bench/sweep_plan.hpp"
 #include "bench/sweep_plan_bench_limits.hpp"
@@ -348,6 +349,50 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                 return r;
               })},
               analysis_schema()));
+  // The one-click report (docs/report.md): the same page and CSV as `synbench report`, built on the worker.
+  const auto text_route = [](Route r, const char* type, const char* what) {
+    r.response_content_type = type;
+    return answering(std::move(r), {{"type", "string"}, {"description", what}});
+  };
+  router.add(text_route({"GET", "/api/sweeps/{id}/report", Role::viewer,
+              "A sweep's report (docs/report.md): one self-contained HTML file (plan, metadata, every figure as inline "
+              "SVG, tables, exclusions), as an attachment named synbench-report-ID-NAME-DATE.html.",
+              worker.offload([db_path](const Request& req) {
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                db::Store* own = thread_store(db_path, err);
+                if (!own) return err;
+                auto report = report::make_sweep_report(*own, *id, report::current_context());
+                if (!report) return db_error(report.error());
+                Response r;
+                r.content_type = "text/html; charset=utf-8";
+                r.body = std::move(report->html);
+                r.headers.emplace_back("Content-Disposition", "attachment; filename=\"" + report->base_name + ".html\"");
+                return r;
+              })},
+              "text/html", "the report page"));
+  router.add(text_route({"GET", "/api/sweeps/{id}/report.csv", Role::viewer,
+              "Every stored point of a sweep as CSV (docs/record.md), unpaged, as an attachment named like the report "
+              "(synbench-report-ID-NAME-DATE.csv).",
+              worker.offload([db_path](const Request& req) {
+                Response err;
+                const auto id = sweep_id(req, err);
+                if (!id) return err;
+                db::Store* own = thread_store(db_path, err);
+                if (!own) return err;
+                auto s = own->get_sweep(*id);
+                if (!s) return db_error(s.error());
+                auto rows = own->points(*id);
+                if (!rows) return db_error(rows.error());
+                Response r;
+                r.content_type = "text/csv; charset=utf-8";
+                r.body = db::points_to_csv(*rows);
+                r.headers.emplace_back("Content-Disposition", "attachment; filename=\"" +
+                                       report::report_base_name(*s, report::current_context().generated_at) + ".csv\"");
+                return r;
+              })},
+              "text/csv", "the points CSV"));
   router.add(answering({"GET", "/api/presets", Role::viewer, "The sweep presets (thesis grid, IEC 61800-9-2) as canonical plans.",
               [](const Request&) {
                 synbench::Json out = synbench::Json::array();

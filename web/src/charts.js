@@ -2,7 +2,7 @@
 // PNG export (ECharts' getDataURL), an "no data yet" note, and data-points="N" (the number of
 // finite data values drawn) for the end-to-end tests.
 import * as echarts from 'echarts/core';
-import { LineChart, HeatmapChart, BarChart, ScatterChart } from 'echarts/charts';
+import { LineChart, HeatmapChart, BarChart, ScatterChart, CustomChart } from 'echarts/charts';
 import {
   GridComponent, TooltipComponent, LegendComponent, VisualMapComponent, TitleComponent, DataZoomComponent,
   MarkLineComponent,
@@ -11,7 +11,7 @@ import { CanvasRenderer } from 'echarts/renderers';
 import { saveBlob } from './api.js';
 import { exportTitledPng } from './export_png.js';
 
-echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, GridComponent, TooltipComponent, LegendComponent,
+echarts.use([LineChart, HeatmapChart, BarChart, ScatterChart, CustomChart, GridComponent, TooltipComponent, LegendComponent,
   VisualMapComponent, TitleComponent, DataZoomComponent, MarkLineComponent, CanvasRenderer]);
 
 // Okabe-Ito based palette: distinguishable with colour-blindness, dark enough on white.

@@ -106,17 +106,24 @@ TEST_F(SweepRoutes, LiveAnswersConformToThePublishedSchemas) {
     if (!methods.contains("get")) continue;
     const auto& ok = methods["get"]["responses"]["200"];
     if (!ok.contains("content")) continue;
-    const auto& schema = ok["content"]["application/json"]["schema"];
     std::string target = pattern;
     if (const auto at = target.find("{id}"); at != std::string::npos) target.replace(at, 4, sid);
     const auto answer = call("GET", target);
     ASSERT_EQ(answer.status, 200) << target << ": " << answer.body;
+    if (!ok["content"].contains("application/json")) {  // the report (text/html) and its CSV (text/csv)
+      const std::string type = ok["content"].items().begin().key();
+      EXPECT_EQ(answer.content_type.rfind(type, 0), 0u) << target << ": " << answer.content_type;
+      EXPECT_FALSE(answer.body.empty()) << target;
+      ++checked;
+      continue;
+    }
+    const auto& schema = ok["content"]["application/json"]["schema"];
     const auto errors = validate(schema, synbench::Json::parse(answer.body));
     EXPECT_TRUE(errors.empty()) << "GET " << target << ": " << to_string(errors);
     ++checked;
   }
-  // status, health, config, lock, whoami, estimators, presets, sweeps, sweep, points, analysis
-  EXPECT_GE(checked, 11u);
+  // status, health, config, lock, whoami, estimators, presets, sweeps, sweep, points, analysis, report, report.csv
+  EXPECT_GE(checked, 13u);
   // The one POST with a published 200 answer.
   const auto estimate = call("POST", "/api/sweeps/estimate", R"({"preset": "thesis-grid"})", "view");
   ASSERT_EQ(estimate.status, 200) << estimate.body;

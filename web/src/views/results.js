@@ -1,5 +1,5 @@
 // Results view: one sweep's analysis drawn as the thesis draws it, with exports.
-import { api, download, saveBlob } from '../api.js';
+import { api, download, saveBlob, getToken } from '../api.js';
 import { ChartCard } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
 import { effMapOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
@@ -8,6 +8,7 @@ import { ResultTables } from './tables.js';
 import { Compare } from './compare.js';
 import { keyboardPoints } from '../chart_keys.js';
 import { sweepDate } from '../export_png.js';
+import { drawContours } from './contours.js';
 
 const $ = (s) => document.querySelector(s);
 const key = (c) => `${c.estimator}/${c.pwm}`;
@@ -21,6 +22,7 @@ export class ResultsView {
     this.app = app;
     this.cards = {
       map: new ChartCard($('[data-chart="r-map"]'), { title: 'Efficiency map P_m / P_dcM at the ME angle' }),
+      contour: new ChartCard($('[data-chart="r-contour"]'), { title: 'Efficiency contours (interpolated, iso-η lines)' }),
       traj: new ChartCard($('[data-chart="r-traj"]'), { title: 'MTPA and ME angle against load (Fig. 6.20)' }),
       curve: new ChartCard($('[data-chart="r-curve"]'), { title: 'I_m and P_dcM against angle' }),
       poserr: new ChartCard($('[data-chart="r-poserr"]'), { title: 'Position error against load (Figs. 6.13-6.15)' }),
@@ -61,6 +63,7 @@ export class ResultsView {
       .catch((e) => app.toast(`export: ${e.message}`, true)));
     $('#r-json').addEventListener('click', () => this.analysis && saveBlob(new Blob([JSON.stringify(this.analysis, null, 2)], { type: 'application/json' }), `sweep-${this.sweepId}-analysis.json`));
     $('#r-acsv').addEventListener('click', () => this.exportAnalysisCsv());
+    $('#r-report').addEventListener('click', () => this.downloadReport());
   }
 
   fillSweeps(list) {
@@ -160,6 +163,7 @@ export class ResultsView {
     const load = Number($('#r-load').value);
     this.cards.map.set(effMapOption(a, cfg));
     this.cards.map.h.textContent = `Efficiency map η = P_m / P_dcM at the ME angle, ${cfgLabel(cfg)}`;
+    drawContours(this.cards.contour, a, cfg, cfgLabel(cfg));
     this.cards.traj.set(trajectoriesOption(a, cfg));
     this.cards.traj.h.textContent = `MTPA (solid) and ME (dashed) angle against load, ${cfgLabel(cfg)}`;
     this.cards.curve.set(curveOption(this.points, a, speed, load, analysisConfigs(a).length ? analysisConfigs(a) : [cfg]));
@@ -171,6 +175,22 @@ export class ResultsView {
     this.cards.hist.h.textContent = `Histograms, ${cfgLabel(cfg)} (Figs. 6.16-6.19)`;
     this.tables.render(a, cfg);
     this.compare.draw(cfg, speed, load);
+  }
+
+  // The report (docs/report.md) and its CSV, each saved under the name the daemon gives.
+  async downloadReport() {
+    const id = this.sweepId;
+    if (!id) return;
+    try {
+      for (const [path, type] of [[`/api/sweeps/${id}/report`, 'text/html'], [`/api/sweeps/${id}/report.csv`, 'text/csv']]) {
+        const res = await fetch(path, { headers: { Authorization: `Bearer ${getToken()}` }, cache: 'no-store' });
+        if (!res.ok) throw new Error(`${path}: HTTP ${res.status}`);
+        const name = /filename="([^"]+)"/.exec(res.headers.get('Content-Disposition') || '')?.[1] || `sweep-${id}-report${type === 'text/csv' ? '.csv' : '.html'}`;
+        saveBlob(new Blob([await res.text()], { type }), name);
+      }
+    } catch (e) {
+      this.app.toast(`report: ${e.message}`, true);
+    }
   }
 
   async exportAnalysisCsv() {

@@ -1,0 +1,322 @@
+// The sweep report's HTML; see sweep_report.hpp and docs/report.md. Numbers are printed at fixed
+// precision (angles 0.01 deg, currents 1 mA, powers 0.1 W, efficiency 1e-4) so the page can be
+// checked against the analysis JSON.
+#include "app/report/sweep_report.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <set>
+
+#include "app/report/svg_plot.hpp"
+#include "bench/efficiency_grid.hpp"
+#include "db/export.hpp"
+#include "synbench/version.hpp"
+
+namespace synbench::report {
+namespace {
+
+using bench::Configuration;
+using bench::label;
+
+std::string fixed(double v, int decimals) {
+  if (!std::isfinite(v)) return "–";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+std::string shortest(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+std::string td(const std::string& s) { return "<td>" + escape_xml(s) + "</td>"; }
+bool same(double a, double b) { return std::fabs(a - b) < 1e-6; }
+
+struct Page {
+  const ReportInput& in;
+  std::string body;
+  std::size_t figures = 0;
+
+  // "..., sweep #3 'name', encoder / capwm": every figure says what, which sweep, which configuration.
+  std::string title(const std::string& what, const Configuration& c) const {
+    return what + " — sweep #" + std::to_string(in.sweep.id) + " '" + in.sweep.meta.name + "', " + label(c);
+  }
+  void figure(const std::string& svg) {
+    ++figures;
+    body += "<figure>" + svg + "</figure>\n";
+  }
+};
+
+void figures_of(Page& p, const Configuration& cfg) {
+  const auto& a = p.in.analysis;
+  // Efficiency map as measured, and interpolated with iso-lines.
+  for (const auto& c : a.efficiency_contours) {
+    if (!(c.configuration == cfg)) continue;
+    HeatPlot m;
+    m.title = p.title("Efficiency map η = P_m / P_dcM at the ME angle [%]", cfg);
+    m.x_label = "speed [rpm]";
+    m.y_label = "load torque T_L [N m]";
+    m.categorical = true;
+    const auto grid = bench::measured_efficiency_grid(a.efficiency, cfg);
+    m.xs = grid.speed_rpm;
+    m.ys = grid.load_Nm;
+    m.z = grid.values;
+    p.figure(svg_heat(m));
+    HeatPlot f;
+    f.title = p.title("Efficiency contours (interpolated, iso-efficiency lines)", cfg);
+    f.x_label = m.x_label;
+    f.y_label = m.y_label;
+    f.xs = c.speed_rpm;
+    f.ys = c.load_Nm;
+    f.z = c.efficiency;
+    f.lines = c.lines;
+    p.figure(svg_heat(f));
+  }
+  // MTPA and ME trajectories; I_m and P_dcM against angle per speed.
+  std::vector<const bench::CurveResult*> curves;
+  for (const auto& c : a.curves)
+    if (c.configuration == cfg) curves.push_back(&c);
+  std::vector<double> speeds;
+  for (const auto* c : curves)
+    if (std::none_of(speeds.begin(), speeds.end(), [&](double s) { return same(s, c->speed_rpm); })) speeds.push_back(c->speed_rpm);
+  if (!curves.empty()) {
+    XYPlot t{p.title("MTPA (solid) and ME (dashed) current angle against load (Fig. 6.20)", cfg), "load torque T_L [N m]",
+             "current angle θ_i [deg]", {}};
+    for (double s : speeds) {
+      XYSeries mtpa{"MTPA " + shortest(s) + " rpm", {}, false}, me{"ME " + shortest(s) + " rpm", {}, true};
+      for (const auto* c : curves)
+        if (same(c->speed_rpm, s)) {
+          mtpa.points.push_back({c->load_Nm, c->mtpa.angle_deg});
+          me.points.push_back({c->load_Nm, c->me.angle_deg});
+        }
+      t.series.push_back(std::move(mtpa));
+      t.series.push_back(std::move(me));
+    }
+    p.figure(svg_xy(t));
+  }
+  std::set<std::size_t> excluded;
+  for (const auto& e : a.excluded) excluded.insert(e.record);
+  for (double s : speeds) {
+    XYPlot im{p.title("I_m against current angle at " + shortest(s) + " rpm", cfg), "current angle θ_i [deg]", "I_m [A]", {}};
+    XYPlot pd{p.title("P_dcM against current angle at " + shortest(s) + " rpm", cfg), "current angle θ_i [deg]", "P_dcM [W]", {}};
+    for (const auto* c : curves) {
+      if (!same(c->speed_rpm, s)) continue;
+      std::vector<const bench::PointRecord*> pts;
+      for (std::size_t i = 0; i < p.in.rows.size(); ++i) {
+        const auto& r = p.in.rows[i].record;
+        if (!excluded.count(i) && r.estimator == cfg.estimator && r.pwm == cfg.pwm && same(r.speed_rpm, s) &&
+            same(r.load_Nm, c->load_Nm))
+          pts.push_back(&r);
+      }
+      std::sort(pts.begin(), pts.end(), [](auto* l, auto* r) { return l->angle_deg < r->angle_deg; });
+      XYSeries a1{shortest(c->load_Nm) + " N m", {}, false}, a2 = a1;
+      for (const auto* r : pts) {
+        a1.points.push_back({r->angle_deg, r->im_A});
+        a2.points.push_back({r->angle_deg, r->pdcm_W});
+      }
+      im.series.push_back(std::move(a1));
+      pd.series.push_back(std::move(a2));
+    }
+    p.figure(svg_xy(im));
+    p.figure(svg_xy(pd));
+  }
+  // Position error against load.
+  XYPlot pe{p.title("Position error against load, min / mean / max (Figs. 6.13-6.15)", cfg), "load torque T_L [N m]",
+            "position error [deg]", {}};
+  for (double s : speeds) {
+    XYSeries mean{"mean " + shortest(s) + " rpm", {}, false}, lo{"min " + shortest(s) + " rpm", {}, true},
+        hi{"max " + shortest(s) + " rpm", {}, true};
+    for (const auto& e : a.position_error)
+      if (e.configuration == cfg && same(e.speed_rpm, s)) {
+        mean.points.push_back({e.load_Nm, e.mean_deg});
+        lo.points.push_back({e.load_Nm, e.min_deg});
+        hi.points.push_back({e.load_Nm, e.max_deg});
+      }
+    if (mean.points.empty()) continue;
+    pe.series.push_back(std::move(mean));
+    pe.series.push_back(std::move(lo));
+    pe.series.push_back(std::move(hi));
+  }
+  if (!pe.series.empty()) p.figure(svg_xy(pe));
+  // Deltas against the reference.
+  XYPlot di{p.title("ΔI_m on the MTPA trajectory vs reference " + label(a.options.reference) + " (Fig. 6.21)", cfg),
+            "load torque T_L [N m]", "ΔI_m [A]", {}};
+  XYPlot dp{p.title("ΔP_dcM on the ME trajectory vs reference " + label(a.options.reference) + " (Fig. 6.21)", cfg),
+            "load torque T_L [N m]", "ΔP_dcM [W]", {}};
+  for (double s : speeds) {
+    XYSeries x1{shortest(s) + " rpm", {}, false}, x2 = x1;
+    for (const auto& d : a.deltas)
+      if (d.configuration == cfg && same(d.speed_rpm, s)) {
+        x1.points.push_back({d.load_Nm, d.mtpa.delta_im_A});
+        x2.points.push_back({d.load_Nm, d.me.delta_pdcm_W});
+      }
+    if (x1.points.empty()) continue;
+    di.series.push_back(std::move(x1));
+    dp.series.push_back(std::move(x2));
+  }
+  if (!di.series.empty()) {
+    p.figure(svg_xy(di));
+    p.figure(svg_xy(dp));
+  }
+  // Histograms.
+  for (const auto& h : a.histograms) {
+    if (!(h.configuration == cfg)) continue;
+    std::vector<Bar> bars;
+    for (const auto& b : h.bins) bars.push_back({b.from, b.to, static_cast<double>(b.count)});
+    p.figure(svg_bars(p.title("Histogram of " + h.quantity + " (Figs. 6.16-6.19)", cfg), h.quantity + " [" + h.unit + "]",
+                      "points", bars));
+  }
+}
+
+std::string json_block(const synbench::Json& j) {
+  return "<pre>" + escape_xml(j.is_null() ? std::string("(none recorded)") : j.dump(2)) + "</pre>";
+}
+
+constexpr const char* kStyle = R"(
+body{font:15px/1.45 system-ui,sans-serif;color:#14181f;max-width:1100px;margin:2em auto;padding:0 1em}
+h1{font-size:1.6em}h2{border-bottom:2px solid #333b47;margin-top:2em}h3{margin-top:1.5em}
+table{border-collapse:collapse;margin:.5em 0;font-variant-numeric:tabular-nums}
+th,td{border:1px solid #c5cad3;padding:2px 8px;text-align:right}th{background:#eef0f4}td:first-child,th:first-child{text-align:left}
+pre{background:#f4f5f8;padding:.6em;overflow:auto;max-height:30em;font-size:13px;white-space:pre-wrap}
+figure{margin:1em 0}svg.plot{width:100%;max-width:860px;height:auto;font:11px sans-serif}
+svg .t{font-size:13px;font-weight:600}svg .l{font-weight:600}svg .g{stroke:#e3e6eb}svg .f{fill:none;stroke:#333b47}
+svg .v{font-size:10px;fill:#000;paint-order:stroke;stroke:#fff;stroke-width:2px}
+svg .iso-label{font-size:11px;font-weight:700;paint-order:stroke;stroke:#fff;stroke-width:3px}
+)";
+
+}  // namespace
+
+std::string report_base_name(const db::Sweep& sweep, const std::string& generated_at) {
+  std::string slug;
+  for (char c : sweep.meta.name) {
+    const bool alnum = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
+    if (alnum) slug += c;
+    else if (c >= 'A' && c <= 'Z') slug += static_cast<char>(c - 'A' + 'a');
+    else if (!slug.empty() && slug.back() != '-') slug += '-';
+    if (slug.size() >= 40) break;
+  }
+  while (!slug.empty() && slug.back() == '-') slug.pop_back();
+  if (slug.empty()) slug = "sweep";
+  return "synbench-report-" + std::to_string(sweep.id) + "-" + slug + "-" + generated_at.substr(0, 10);
+}
+
+std::string render_report(const ReportInput& in) {
+  const auto& s = in.sweep;
+  const auto& a = in.analysis;
+  Page p{in, {}, 0};
+  const std::string name = "Sweep #" + std::to_string(s.id) + " '" + s.meta.name + "'";
+  std::string& b = p.body;
+  b += "<h1>" + escape_xml(name) + "</h1>\n<p class=\"generated\">Report generated <time>" + escape_xml(in.context.generated_at) +
+       "</time> by synbench " + escape_xml(kVersion) + " on " + escape_xml(in.context.host) + ".</p>\n";
+  b += "<h2 id=\"sweep\">Sweep</h2>\n<table id=\"sweep-table\">";
+  const auto row = [&b](const std::string& k, const std::string& v) { b += "<tr><th>" + escape_xml(k) + "</th>" + td(v) + "</tr>"; };
+  row("id", std::to_string(s.id));
+  row("name", s.meta.name);
+  row("state", std::string(db::name(s.state)));
+  row("created", s.created_at);
+  row("started", s.started_at.value_or("–"));
+  row("finished", s.finished_at.value_or("–"));
+  row("points stored / planned", std::to_string(s.points_stored) + " / " + std::to_string(s.meta.total_points));
+  row("points used in the analysis", std::to_string(a.used) + " of " + std::to_string(a.records));
+  if (s.last_error) row("last error", *s.last_error);
+  b += "</table>\n<h2 id=\"metadata\">Bench and software</h2>\n<table id=\"meta-table\">";
+  row("synbench version that ran the sweep", s.meta.software_version);
+  row("synbench version of this report", kVersion);
+  row("host of this report", in.context.host);
+  row("bench", s.meta.bench_config.is_null() ? "none recorded" : "the configuration recorded with the sweep, below");
+  row("reference configuration (deltas)", label(a.options.reference));
+  b += "</table>\n<h3>Bench configuration (a bench config, or the twin's config)</h3>" + json_block(s.meta.bench_config) + "<h3>Device profiles</h3>" +
+       json_block(s.meta.profiles) + "<h3>Calibration</h3>" + json_block(s.meta.calibration) +
+       "\n<h2 id=\"plan\">Plan</h2>" + json_block(s.meta.plan);
+
+  std::vector<Configuration> configs;
+  for (const auto& c : a.curves)
+    if (std::find(configs.begin(), configs.end(), c.configuration) == configs.end()) configs.push_back(c.configuration);
+  b += "\n<h2 id=\"figures\">Figures</h2>\n";
+  if (configs.empty()) b += "<p>No point of this sweep is usable: nothing to draw.</p>";
+  for (const auto& cfg : configs) {
+    b += "<h3>" + escape_xml(label(cfg)) + "</h3>\n";
+    figures_of(p, cfg);
+  }
+
+  b += "\n<h2 id=\"tables\">Tables</h2>\n<h3>MTPA and ME optima per configuration, speed and load</h3>\n"
+       "<table id=\"optima\"><thead><tr><th>estimator</th><th>pwm</th><th>speed_rpm</th><th>load_Nm</th><th>points</th>"
+       "<th>MTPA angle_deg</th><th>MTPA im_A</th><th>MTPA pdcm_W</th><th>MTPA efficiency</th>"
+       "<th>ME angle_deg</th><th>ME im_A</th><th>ME pdcm_W</th><th>ME efficiency</th></tr></thead><tbody>";
+  const auto opt = [](const bench::CurveOptimum& o) {
+    return td(fixed(o.angle_deg, 2)) + td(fixed(o.im_A, 3)) + td(fixed(o.pdcm_W, 1)) +
+           td(o.pdcm_W > 0 ? fixed(o.efficiency, 4) : "–");
+  };
+  for (const auto& c : a.curves)
+    b += "<tr>" + td(std::string(drivers::name(c.configuration.estimator))) + td(std::string(drivers::name(c.configuration.pwm))) +
+         td(shortest(c.speed_rpm)) + td(shortest(c.load_Nm)) + td(std::to_string(c.points)) + opt(c.mtpa) + opt(c.me) + "</tr>";
+  b += "</tbody></table>\n";
+  for (const auto& cfg : configs) {
+    const auto grid = bench::measured_efficiency_grid(a.efficiency, cfg);
+    b += "<h3>Efficiency at the ME angle, speed x load, " + escape_xml(label(cfg)) + "</h3>\n<table class=\"eta-grid\" data-estimator=\"" +
+         std::string(drivers::name(cfg.estimator)) + "\" data-pwm=\"" + std::string(drivers::name(cfg.pwm)) +
+         "\"><thead><tr><th>speed_rpm \\ load_Nm</th>";
+    for (double l : grid.load_Nm) b += "<th>" + shortest(l) + "</th>";
+    b += "</tr></thead><tbody>";
+    for (std::size_t k = 0; k < grid.speed_rpm.size(); ++k) {  // rows: speed, as the analysis' efficiency_map
+      b += "<tr><th>" + shortest(grid.speed_rpm[k]) + "</th>";
+      for (std::size_t r = 0; r < grid.load_Nm.size(); ++r) b += td(grid.values[r][k] ? fixed(*grid.values[r][k], 4) : "–");
+      b += "</tr>";
+    }
+    b += "</tbody></table>\n";
+  }
+  b += "\n<h2 id=\"exclusions\">Exclusions</h2>\n";
+  if (a.excluded.empty()) b += "<p>No point was left out.</p>";
+  else {
+    b += "<table id=\"excluded\"><thead><tr><th>record</th><th>configuration</th><th>speed_rpm</th><th>load_Nm</th>"
+         "<th>angle_deg</th><th>reasons</th></tr></thead><tbody>";
+    for (const auto& e : a.excluded) {
+      std::string reasons;
+      for (const auto& r : e.reasons) reasons += (reasons.empty() ? "" : ", ") + r;
+      b += "<tr>" + td(std::to_string(e.record)) + td(label(e.configuration)) + td(shortest(e.speed_rpm)) +
+           td(shortest(e.load_Nm)) + td(shortest(e.angle_deg)) + td(reasons) + "</tr>";
+    }
+    b += "</tbody></table>";
+  }
+  return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>synbench report: " + escape_xml(name) +
+         "</title><style>" + kStyle + "</style></head><body>\n" + b + "\n<p class=\"figures\">" +
+         std::to_string(p.figures) + " figures.</p></body></html>\n";
+}
+
+db::Result<SweepReport> make_sweep_report(db::Store& store, std::int64_t sweep_id, const ReportContext& context) {
+  auto sweep = store.get_sweep(sweep_id);
+  if (!sweep) return sweep.error();
+  auto rows = store.points(sweep_id);
+  if (!rows) return rows.error();
+  std::vector<bench::PointRecord> records;
+  records.reserve(rows->size());
+  for (const auto& r : *rows) records.push_back(r.record);
+  ReportInput in{*sweep, *rows, bench::analyze(records), context};
+  SweepReport out;
+  out.base_name = report_base_name(in.sweep, context.generated_at);
+  out.html = render_report(in);
+  out.csv = db::points_to_csv(*rows);
+  return out;
+}
+
+ReportContext current_context() {
+  ReportContext c;
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  c.generated_at = buf;
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  c.host = host[0] ? host : "unknown host";
+  return c;
+}
+
+}  // namespace synbench::report
