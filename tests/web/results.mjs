@@ -165,7 +165,7 @@ try {
   const wantMap = `load torque T_L [N m] ${em.loads_Nm[0]}, speed [rpm] ${em.speeds_rpm[0]}: ${Number((em.efficiency[0][0] * 100).toFixed(1))}`;
   const mapRead = await text(page, '[data-chart="r-map"] .point-readout');
   check(s500 === 0 && mapRead.includes(wantMap), `the map's first cell is read out: ${mapRead}`);
-  for (let i = 0; i < 3 && !(await page.evaluate(() => document.activeElement?.closest('[data-chart="r-traj"]') && document.activeElement.classList.contains('chart'))); i++)
+  for (let i = 0; i < 10 && !(await page.evaluate(() => document.activeElement?.closest('[data-chart="r-traj"]') && document.activeElement.classList.contains('chart'))); i++)
     await page.keyboard.press('Tab');
   const cur = A.curves.entries.filter((e) => ckey(e) === ckey(cfg) && e.speed_rpm === 500).sort((p, q) => p.load_Nm - q.load_Nm);
   await page.keyboard.press('ArrowRight');
