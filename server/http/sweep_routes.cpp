@@ -136,6 +136,20 @@ db::Store* thread_store(const std::filesystem::path& path, Response& error) {
   return &stores.emplace(path, std::move(*opened)).first->second;
 }
 
+// The sweep a route names and the calling thread's store: what each worker route on one sweep
+// reads first (nullopt with `error` set when the id or the store fails).
+struct SweepInStore {
+  std::int64_t id;
+  db::Store& store;
+};
+std::optional<SweepInStore> sweep_in_store(const Request& req, const std::filesystem::path& db_path, Response& error) {
+  const auto id = sweep_id(req, error);
+  if (!id) return std::nullopt;
+  db::Store* own = thread_store(db_path, error);
+  if (!own) return std::nullopt;
+  return SweepInStore{*id, *own};
+}
+
 // The plan's points before speed restrictions: what its estimate costs.
 std::size_t size_bound(const bench::SweepPlan& p) {
   const std::size_t pairs = p.operating_points.empty() ? p.speeds_rpm.size() * p.loads_Nm.size() : p.operating_points.size();
@@ -288,16 +302,14 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               "(at most 10000 a page; X-Total-Count gives the total).",
               worker.offload([db_path](const Request& req) {
                 Response err;
-                const auto id = sweep_id(req, err);
-                if (!id) return err;
+                const auto sweep = sweep_in_store(req, db_path, err);
+                if (!sweep) return err;
                 const auto format = format_of(req, err);
                 if (!format) return err;
                 const auto page = page_of(req, err);
                 if (!page) return err;
-                db::Store* own = thread_store(db_path, err);
-                if (!own) return err;
-                if (auto s = own->get_sweep(*id); !s) return db_error(s.error());
-                auto rows = own->points(*id);
+                if (auto s = sweep->store.get_sweep(sweep->id); !s) return db_error(s.error());
+                auto rows = sweep->store.points(sweep->id);
                 if (!rows) return db_error(rows.error());
                 const std::span<const db::PointRow> all(*rows);
                 const std::size_t first = std::min(page->offset, all.size());
@@ -318,12 +330,10 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               "?reference=ESTIMATOR/PWM (default encoder/capwm) for the deltas.",
               worker.offload([db_path](const Request& req) {
                 Response err;
-                const auto id = sweep_id(req, err);
-                if (!id) return err;
+                const auto sweep = sweep_in_store(req, db_path, err);
+                if (!sweep) return err;
                 const auto format = format_of(req, err);
                 if (!format) return err;
-                db::Store* own = thread_store(db_path, err);
-                if (!own) return err;
                 bench::AnalysisOptions options;
                 if (req.query.count("reference")) {
                   const auto ref = parse_configuration_label(req.query.at("reference"));
@@ -332,8 +342,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                                                                 "' is not ESTIMATOR/PWM (e.g. encoder/capwm)");
                   options.reference = *ref;
                 }
-                if (auto s = own->get_sweep(*id); !s) return db_error(s.error());
-                auto rows = own->points(*id);
+                if (auto s = sweep->store.get_sweep(sweep->id); !s) return db_error(s.error());
+                auto rows = sweep->store.points(sweep->id);
                 if (!rows) return db_error(rows.error());
                 std::vector<bench::PointRecord> records;
                 records.reserve(rows->size());
@@ -359,11 +369,9 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               "SVG, tables, exclusions), as an attachment named synbench-report-ID-NAME-DATE.html.",
               worker.offload([db_path](const Request& req) {
                 Response err;
-                const auto id = sweep_id(req, err);
-                if (!id) return err;
-                db::Store* own = thread_store(db_path, err);
-                if (!own) return err;
-                auto report = report::make_sweep_report(*own, *id, report::current_context());
+                const auto sweep = sweep_in_store(req, db_path, err);
+                if (!sweep) return err;
+                auto report = report::make_sweep_report(sweep->store, sweep->id, report::current_context());
                 if (!report) return db_error(report.error());
                 Response r;
                 r.content_type = "text/html; charset=utf-8";
@@ -377,13 +385,11 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
               "(synbench-report-ID-NAME-DATE.csv).",
               worker.offload([db_path](const Request& req) {
                 Response err;
-                const auto id = sweep_id(req, err);
-                if (!id) return err;
-                db::Store* own = thread_store(db_path, err);
-                if (!own) return err;
-                auto s = own->get_sweep(*id);
+                const auto sweep = sweep_in_store(req, db_path, err);
+                if (!sweep) return err;
+                auto s = sweep->store.get_sweep(sweep->id);
                 if (!s) return db_error(s.error());
-                auto rows = own->points(*id);
+                auto rows = sweep->store.points(sweep->id);
                 if (!rows) return db_error(rows.error());
                 Response r;
                 r.content_type = "text/csv; charset=utf-8";
