@@ -8,6 +8,7 @@
 #include <map>
 
 #include "bench/analysis.hpp"
+#include "bench/efficiency_grid.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -198,34 +199,18 @@ ojson to_json(const Analysis& a) {
   std::map<Configuration, std::vector<const EfficiencyCell*>> by_config;
   for (const auto& c : a.efficiency) by_config[c.configuration].push_back(&c);
   for (const auto& [config, cells] : by_config) {
-    std::vector<double> speeds, loads;
-    auto add = [](std::vector<double>& v, double x) {
-      for (double y : v)
-        if (std::fabs(y - x) < 1e-6) return;
-      v.push_back(x);
-    };
-    for (const auto* c : cells) {
-      add(speeds, c->speed_rpm);
-      add(loads, c->load_Nm);
-    }
-    std::sort(speeds.begin(), speeds.end());
-    std::sort(loads.begin(), loads.end());
+    // The one measured grid (bench/efficiency_grid.hpp, rows = load) served here rows = speed.
+    const MeasuredGrid g = measured_efficiency_grid(a.efficiency, config);
     ojson matrix = ojson::array();
-    for (double s : speeds) {
+    for (std::size_t i = 0; i < g.speed_rpm.size(); ++i) {
       ojson row = ojson::array();
-      for (double l : loads) {
-        ojson v = nullptr;
-        for (const auto* c : cells)
-          if (std::fabs(c->speed_rpm - s) < 1e-6 && std::fabs(c->load_Nm - l) < 1e-6 && c->pdcm_W > 0)
-            v = number(c->efficiency);
-        row.push_back(v);
-      }
+      for (std::size_t k = 0; k < g.load_Nm.size(); ++k) row.push_back(g.values[k][i] ? number(*g.values[k][i]) : ojson(nullptr));
       matrix.push_back(row);
     }
     ojson m = ojson::object();
     put_configuration(m, config);
-    m["speeds_rpm"] = speeds;
-    m["loads_Nm"] = loads;
+    m["speeds_rpm"] = g.speed_rpm;
+    m["loads_Nm"] = g.load_Nm;
     m["efficiency"] = matrix;
     ojson list = ojson::array();
     for (const auto* c : cells) {
