@@ -50,6 +50,13 @@ struct PointRecord {
   // angle_meas_deg is further from angle_deg than the measurement allows at this current: the
   // drive did not run at the requested angle (a warning; false below the current it is judged at).
   bool angle_off = false;
+  // Standard uncertainties (k = 1, GUM) of the measured values (bench/uncertainty.hpp,
+  // docs/uncertainty.md): `_u` the combined one, `_u_repeat` its part that is independent from
+  // point to point (type A and quantisation), which a difference between two points of one
+  // bench carries. Empty where no budget could be formed and on rows stored before them.
+  std::optional<double> im_u_A, im_u_repeat_A;
+  std::optional<double> pdcm_u_W, pdcm_u_repeat_W, pdcg_u_W, pm_u_W;
+  std::optional<double> efficiency_u, efficiency_u_repeat;
   // emulator only: the plant's own values over the window
   std::optional<drivers::TruthWindow> truth;
 };

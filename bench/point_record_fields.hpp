@@ -82,6 +82,14 @@ inline constexpr std::tuple kPointRecordFields{
     Field{"fault_code_raw", &PointRecord::fault_code_raw},  // schema version 6
     Field{"angle_meas_deg", &PointRecord::angle_meas_deg},  // schema version 7
     Field{"angle_off", &PointRecord::angle_off},
+    Field{"im_u_A", &PointRecord::im_u_A},  // schema version 8
+    Field{"pdcm_u_W", &PointRecord::pdcm_u_W},
+    Field{"pdcg_u_W", &PointRecord::pdcg_u_W},
+    Field{"pm_u_W", &PointRecord::pm_u_W},
+    Field{"efficiency_u", &PointRecord::efficiency_u},
+    Field{"im_u_repeat_A", &PointRecord::im_u_repeat_A},
+    Field{"pdcm_u_repeat_W", &PointRecord::pdcm_u_repeat_W},
+    Field{"efficiency_u_repeat", &PointRecord::efficiency_u_repeat},
     Field{"truth", &PointRecord::truth},  // a nested table (kTruthFields); its own column
 };
 

@@ -133,6 +133,19 @@ ALTER TABLE points ADD COLUMN angle_meas_deg ANY CHECK (typeof(angle_meas_deg) I
 ALTER TABLE points ADD COLUMN angle_off INTEGER NOT NULL DEFAULT 0 CHECK (angle_off IN (0, 1));
 )sql";
 
+// Version 8: the standard uncertainties of the measured values (docs/uncertainty.md), combined
+// and their point-to-point part. Rows from before have none (NULL).
+constexpr std::string_view kSchemaV8 = R"sql(
+ALTER TABLE points ADD COLUMN im_u_A ANY CHECK (typeof(im_u_A) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN pdcm_u_W ANY CHECK (typeof(pdcm_u_W) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN pdcg_u_W ANY CHECK (typeof(pdcg_u_W) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN pm_u_W ANY CHECK (typeof(pm_u_W) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN efficiency_u ANY CHECK (typeof(efficiency_u) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN im_u_repeat_A ANY CHECK (typeof(im_u_repeat_A) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN pdcm_u_repeat_W ANY CHECK (typeof(pdcm_u_repeat_W) IN ('real', 'null'));
+ALTER TABLE points ADD COLUMN efficiency_u_repeat ANY CHECK (typeof(efficiency_u_repeat) IN ('real', 'null'));
+)sql";
+
 constexpr std::array kMigrations{
     Migration{1, "sweeps, points (experiment.md Sec. 2.5 fields), events", kSchemaV1},
     Migration{2, "points: below_min_speed, fallback_fraction", kSchemaV2},
@@ -141,6 +154,7 @@ constexpr std::array kMigrations{
     Migration{5, "points: window_source", kSchemaV5},
     Migration{6, "points: fault_code_raw", kSchemaV6},
     Migration{7, "points: angle_meas_deg, angle_off", kSchemaV7},
+    Migration{8, "points: im_u_A, pdcm_u_W, pdcg_u_W, pm_u_W, efficiency_u and their _u_repeat parts", kSchemaV8},
 };
 
 struct Header {

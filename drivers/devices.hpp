@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "drivers/fault.hpp"
 #include "drivers/modes.hpp"
@@ -92,6 +93,10 @@ struct SynrmWindow {
   WindowKeeper keeper = WindowKeeper::device;
   std::optional<std::int64_t> fault_code_raw;  // the device's code of an unknown fault
   HostSampling host;  // keeper host only
+  // The window's means over its equal consecutive sub-windows (batches), in time order: the
+  // type A uncertainty of the window's mean comes from their scatter (bench/uncertainty.hpp).
+  // Empty when the device keeps no batches.
+  std::vector<double> batch_im_A, batch_speed_meas_rpm;
 };
 
 // The step of each telemetry value the frozen-telemetry check watches, as the drive's registers
@@ -139,6 +144,7 @@ struct LoadWindow {
   WindowKeeper keeper = WindowKeeper::device;
   double window_s = 0;  // keeper host: from the first sample to the last; else 0 (not reported)
   HostSampling host;    // keeper host only
+  std::vector<double> batch_torque_Nm;  // as SynrmWindow's batches
 };
 
 class LoadDrive {
@@ -168,6 +174,9 @@ struct MeterReading {
   WindowKeeper keeper = WindowKeeper::device;
   std::uint32_t samples = 0;  // host-kept: the polls averaged
   HostSampling host;          // keeper host only
+  // Pulses counted in each of the gate's equal consecutive sub-gates, in time order (they sum to
+  // counts_m, counts_g): the type A uncertainty of the gate's currents. Empty without batches.
+  std::vector<std::uint64_t> batch_counts_m, batch_counts_g;
 };
 
 class PowerMeter {

@@ -54,7 +54,8 @@ TEST(CsvExport, HeaderIsTheRecordFieldsThenTruthColumns) {
       "point_index,speed_rpm,load_Nm,angle_deg,estimator,pwm,speed_meas_rpm,im_A,id_A,iq_A,ud_V,uq_V,"
       "udc_V,idcm_A,idcg_A,pdcm_W,pdcg_W,pm_W,efficiency,pos_err_min_deg,pos_err_mean_deg,"
       "pos_err_max_deg,speed_err_rpm,ld_est_H,lq_est_H,rs_est_ohm,ld_err_pct,lq_err_pct,rs_err_pct,"
-      "temp_C,window_s,samples,settle_s,voltage_limited,unstable,fault,below_min_speed,fallback_fraction,lock_lost,window_source,fault_code_raw,angle_meas_deg,angle_off,truth_pin_W,truth_pcu_W,"
+      "temp_C,window_s,samples,settle_s,voltage_limited,unstable,fault,below_min_speed,fallback_fraction,lock_lost,window_source,fault_code_raw,angle_meas_deg,angle_off,"
+      "im_u_A,pdcm_u_W,pdcg_u_W,pm_u_W,efficiency_u,im_u_repeat_A,pdcm_u_repeat_W,efficiency_u_repeat,truth_pin_W,truth_pcu_W,"
       "truth_pfe_W,truth_pmech_W,truth_pinvm_W,truth_pm_W,truth_temp_C\n";
   EXPECT_EQ(points_to_csv({}), expected);
 }
@@ -71,7 +72,7 @@ TEST(CsvExport, HeaderIsToJsonsKeysWithTruthFlattened) {
       for (const auto& [tkey, tvalue] : value.items()) expected.push_back(key + "_" + tkey);
   }
   EXPECT_EQ(csv_columns(), expected);
-  EXPECT_EQ(csv_columns().size(), 50u) << "docs/database.md gives the count";
+  EXPECT_EQ(csv_columns().size(), 58u) << "docs/database.md gives the count";
 }
 
 TEST(CsvExport, EveryValueReadsBackExactly) {

@@ -167,6 +167,14 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN efficiency_u_repeat");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_repeat_W");
+    raw.exec("ALTER TABLE points DROP COLUMN im_u_repeat_A");
+    raw.exec("ALTER TABLE points DROP COLUMN efficiency_u");
+    raw.exec("ALTER TABLE points DROP COLUMN pm_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcg_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN im_u_A");
     raw.exec("ALTER TABLE points DROP COLUMN angle_off");
     raw.exec("ALTER TABLE points DROP COLUMN angle_meas_deg");
     raw.exec("ALTER TABLE points DROP COLUMN window_source");
@@ -210,6 +218,14 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
   }
   {
     Raw raw(path);
+    raw.exec("ALTER TABLE points DROP COLUMN efficiency_u_repeat");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_repeat_W");
+    raw.exec("ALTER TABLE points DROP COLUMN im_u_repeat_A");
+    raw.exec("ALTER TABLE points DROP COLUMN efficiency_u");
+    raw.exec("ALTER TABLE points DROP COLUMN pm_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcg_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_W");
+    raw.exec("ALTER TABLE points DROP COLUMN im_u_A");
     raw.exec("ALTER TABLE points DROP COLUMN angle_off");
     raw.exec("ALTER TABLE points DROP COLUMN angle_meas_deg");
     raw.exec("ALTER TABLE points DROP COLUMN window_source");

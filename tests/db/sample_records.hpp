@@ -31,6 +31,16 @@ inline bench::PointRecord sample_record(std::int64_t i) {
   r.iq_A = std::sin(x);
   if (i % 13 != 12) r.angle_meas_deg = i % 2 == 0 ? 45.0 + 1e-7 * x : 90.0 - 1.0 / (3.0 + x);  // null on some
   r.angle_off = i % 8 == 6;
+  if (i % 9 != 4) {  // null on some
+    r.im_u_A = 1e-4 * (1 + x);
+    r.im_u_repeat_A = 1e-5 / (1 + x);
+    r.pdcm_u_W = 0.1 * x + 1.0 / 3.0;
+    r.pdcm_u_repeat_W = 0.01 + 1e-12 * x;
+    r.pdcg_u_W = 0.2 + x;
+    r.pm_u_W = 3e-3 * (2 + x);
+    r.efficiency_u = 1e-3 / (3 + x);
+    r.efficiency_u_repeat = 1e-5 * (5 + x);
+  }
   r.ud_V = -std::numeric_limits<double>::denorm_min() * static_cast<double>(i % 3);  // subnormal
   r.uq_V = 1e-300 * x;
   r.udc_V = 565.0 + std::nextafter(0.0, 1.0) * x;
