@@ -14,7 +14,8 @@ RECORD_FIELDS = """speed_rpm load_Nm angle_deg estimator pwm speed_meas_rpm im_A
 udc_V idcm_A idcg_A pdcm_W pdcg_W pm_W efficiency pos_err_min_deg pos_err_mean_deg pos_err_max_deg
 speed_err_rpm ld_est_H lq_est_H rs_est_ohm ld_err_pct lq_err_pct rs_err_pct temp_C window_s samples
 settle_s voltage_limited unstable fault below_min_speed fallback_fraction lock_lost window_source fault_code_raw
-angle_meas_deg angle_off truth""".split()
+angle_meas_deg angle_off im_u_A pdcm_u_W pdcg_u_W pm_u_W efficiency_u im_u_repeat_A pdcm_u_repeat_W
+efficiency_u_repeat truth""".split()
 TRUTH_FIELDS = "pin_W pcu_W pfe_W pmech_W pinvm_W pm_W temp_C".split()
 check = Checks(verbose=True)
 
