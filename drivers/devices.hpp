@@ -177,6 +177,9 @@ struct MeterReading {
   // Pulses counted in each of the gate's equal consecutive sub-gates, in time order (they sum to
   // counts_m, counts_g): the type A uncertainty of the gate's currents. Empty without batches.
   std::vector<std::uint64_t> batch_counts_m, batch_counts_g;
+  // The nominal calibration idcm_A and idcg_A were computed with (I = (N / T_g - f0) / Kf): what
+  // turns batch counts into currents and a count into its current. 0 when not a VFC gate.
+  double f0_Hz = 0, kf_Hz_per_A = 0;
 };
 
 class PowerMeter {
