@@ -38,6 +38,12 @@ const f = (v, d) => (v == null || !Number.isFinite(v) ? '–' : v.toFixed(d));
 const ckey = (c) => `${c.estimator}/${c.pwm}`;
 const pkey = (c) => `${ckey(c)}|${c.speed_rpm}|${c.load_Nm}`;
 const rows = (page, sel) => page.$$eval(`${sel} tbody tr`, (trs) => trs.map((tr) => [...tr.children].map((c) => c.textContent.trim())));
+// the columns of a table named in want (its other columns, the uncertainties, are uncertainty.mjs's)
+const columns = async (page, sel, want) => {
+  const head = await page.$$eval(`${sel} thead th`, (ths) => ths.map((c) => c.textContent.trim()));
+  const k = want.map((h) => head.indexOf(h));
+  return (await rows(page, sel)).map((r) => k.map((i) => r[i]));
+};
 
 try {
   const A = await get('/api/sweeps/1/analysis');
@@ -71,7 +77,7 @@ try {
     if (x && y) {
       const want = ['both', f(y.mtpa.angle_deg - x.mtpa.angle_deg, 2), f(y.me.angle_deg - x.me.angle_deg, 2),
         f((y.me.efficiency - x.me.efficiency) * 100, 2), f(y.me.pdcm_W - x.me.pdcm_W, 2)];
-      if (JSON.stringify(r.slice(3)) === JSON.stringify(want)) same++; else bad.push(`${k}: ${r.slice(3)} != ${want}`);
+      if (JSON.stringify(r.slice(3, 8)) === JSON.stringify(want)) same++; else bad.push(`${k}: ${r.slice(3)} != ${want}`);
     } else if (x && r[3] === 'only in #1' && r.slice(4).every((c) => c === '–')) onlyA++;
     else if (y && r[3] === 'only in #2' && r.slice(4).every((c) => c === '–')) onlyB++;
     else bad.push(`${k}: ${r}`);
@@ -88,7 +94,7 @@ try {
     `the trajectory overlay has both runs' MTPA and ME series, labelled by sweep (${opts.traj.slice(0, 2).join(', ')} ...)`);
   check(opts.curve.filter((n) => n.startsWith('sweep #1')).length === 2 && opts.curve.filter((n) => n.startsWith('sweep #2')).length === 2,
     `the I_m/P_dcM overlay has both runs' curves (${opts.curve.join(', ')})`);
-  const dMtpa = opts.diff.find((s) => s.name === 'Δ MTPA angle').data;
+  const dMtpa = opts.diff.find((s) => s.name === 'Δ MTPA angle').data.map((d) => d?.value ?? d);
   const wantMtpa = [...ea.values()].filter((x) => ckey(x) === ckey(cfg) && eb.has(pkey(x)))
     .sort((p, q) => p.speed_rpm - q.speed_rpm || p.load_Nm - q.load_Nm)
     .map((x) => Number((eb.get(pkey(x)).mtpa.angle_deg - x.mtpa.angle_deg).toFixed(4)));
@@ -107,7 +113,8 @@ try {
   check(await until(async () => page.url().endsWith('#/results/1/vs/2') && !(await page.$eval('#r-compare', (e) => e.hidden)), 10000), 'choosing sweep #2 again puts /vs/2 in the URL');
 
   // ---- 2. numeric tables ----
-  const optima = await rows(page, '#r-optima');
+  const optima = await columns(page, '#r-optima', ['configuration', 'speed [rpm]', 'load [N m]',
+    ...['MTPA', 'ME'].flatMap((t) => [`${t} angle [deg]`, `${t} I_m [A]`, `${t} P_dcM [W]`, `${t} η [%]`, `${t} note`])]);
   const order = ['encoder/capwm', 'ekf-basic/aspwm'];
   const want = A.curves.entries.slice().sort((p, q) => order.indexOf(ckey(p)) - order.indexOf(ckey(q)) || p.speed_rpm - q.speed_rpm || p.load_Nm - q.load_Nm)
     .map((e) => {
@@ -118,7 +125,7 @@ try {
   check(want.some((r) => r[7] === 'at edge' || r[12] === 'at edge') ? optima.some((r) => r[7] === 'at edge' || r[12] === 'at edge') : optima.some((r) => r[7] === 'refined'),
     'the optima table marks "at edge" / "refined" as the analysis does');
   const em = A.efficiency_map.entries.find((e) => ckey(e) === ckey(cfg));
-  const eff = await rows(page, '#r-eff');
+  const eff = await columns(page, '#r-eff', ['load [N m]', ...em.speeds_rpm.map((s) => `η [%] at ${s} rpm`)]);
   const wantEff = em.loads_Nm.map((l, j) => [f(l, 2), ...em.speeds_rpm.map((s, i) => f(em.efficiency[i][j] * 100, 1))]);
   check(JSON.stringify(eff) === JSON.stringify(wantEff), `the efficiency table (rows load, columns speed) equals the map (${JSON.stringify(eff[0])})`);
   await page.click('#r-optima-copy');

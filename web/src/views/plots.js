@@ -1,34 +1,76 @@
 // ECharts options of the result plots, shared by the progress panel and the results view. Input
 // is the analysis JSON (docs/analysis.md) or the points JSON (docs/record.md).
 import { axis, PALETTE } from '../charts.js';
+import { errorBarSeries, pm, fmtU, known, sigText, BARS_NOTE, NO_U_NOTE } from '../errorbars.js';
 
 const r2 = (v, d = 2) => (v == null || !Number.isFinite(v) ? null : Number(v.toFixed(d)));
 export const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
 export const cfgLabel = (c) => `${c.estimator} / ${c.pwm}`;
 
+// The chart's note on its bars: "bars: ±2u, 95 %" when any bar is drawn, else "no uncertainty stored".
+export const uNote = (series, extra = '') => ({ text: series.some((s) => s?.errorBars) ? `${BARS_NOTE}${extra}` : NO_U_NOTE,
+  right: 8, bottom: 0, textStyle: { fontSize: 11, fontWeight: 'normal', color: '#4a5361' } });
+// Axis tooltip lines "● name: value ± u unit (k=1)" of the series that are not error bars.
+const uTooltip = (unitOf, digits) => (params) => [].concat(params).filter((p) => p.seriesType !== 'custom' && p.value != null)
+  .map((p, k, all) => `${k === 0 ? `${Array.isArray(p.value) ? p.value[0] : p.name}<br>` : ''}${p.marker}${p.seriesName}: `
+    + `${pm(Array.isArray(p.value) ? p.value[1] : p.value, p.data?.u, unitOf(p), digits(p))}${p.data?.significant === false ? ' — not significant at 95 %' : ''}`)
+  .join('<br>');
+
 // Efficiency map (P_m / P_dcM at the ME angle) over load x speed, as a heat map with values.
-export function effMapOption(analysis, cfg) {
+// showU: the map of the efficiency's standard uncertainty u (percentage points) instead of η.
+export function effMapOption(analysis, cfg, showU = false) {
   const e = (analysis?.efficiency_map?.entries || []).find((x) => sameCfg(x, cfg)) || analysis?.efficiency_map?.entries?.[0];
   if (!e) return { series: [] };
   const data = [];
   e.speeds_rpm.forEach((s, i) => e.loads_Nm.forEach((l, j) => {
     const v = e.efficiency[i]?.[j];
-    if (v != null) data.push([j, i, r2(v * 100, 1)]);
+    const u = e.efficiency_u?.[i]?.[j];
+    const shown = showU ? (known(u) ? r2(u * 100, 4) : null) : r2(v * 100, 1);
+    if (v != null && shown != null) data.push({ value: [j, i, shown], eta: v, u: known(u) ? u : null, ur: e.efficiency_u_repeat?.[i]?.[j] ?? null });
   }));
-  const vals = data.map((d) => d[2]);
+  const vals = data.map((d) => d.value[2]);
+  const tip = (p) => `${e.speeds_rpm[p.value[1]]} rpm, ${e.loads_Nm[p.value[0]]} N m<br>η = ${known(p.data.u) ? `${(p.data.eta * 100).toFixed(2)} ± ${fmtU(p.data.u * 100)} % (k=1)`
+    + `${known(p.data.ur) ? `<br>point-to-point part ${fmtU(p.data.ur * 100)} %` : ''}` : `${(p.data.eta * 100).toFixed(1)} % (${NO_U_NOTE})`}`;
+  const lo = vals.length ? Math.min(...vals) : 0, hi = vals.length ? Math.max(...vals) : 100;
   return {
-    tooltip: { trigger: 'item', formatter: (p) => `${e.speeds_rpm[p.value[1]]} rpm, ${e.loads_Nm[p.value[0]]} N m<br>η = ${p.value[2]} %` },
+    title: uNote(data.some((d) => d.u != null) ? [{ errorBars: true }] : [], showU ? ' · showing u [%]' : ''),
+    tooltip: { trigger: 'item', formatter: tip },
     grid: { left: 64, right: 80, top: 24, bottom: 40 },
     xAxis: { type: 'category', name: 'load torque T_L [N m]', nameLocation: 'middle', nameGap: 26, data: e.loads_Nm.map(String),
       axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
     yAxis: { type: 'category', name: 'speed [rpm]', nameLocation: 'middle', nameGap: 44, data: e.speeds_rpm.map(String),
       axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
-    visualMap: { min: vals.length ? Math.floor(Math.min(...vals) / 5) * 5 : 0, max: vals.length ? Math.ceil(Math.max(...vals) / 5) * 5 : 100,
-      calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160, text: ['η %', ''], textStyle: { color: '#14181f' },
-      inRange: { color: ['#313695', '#4575b4', '#74add1', '#abd9e9', '#fee090', '#fdae61', '#f46d43', '#a50026'] } },
-    series: [{ name: `efficiency ${cfgLabel(e)}`, type: 'heatmap', data,
-      label: { show: data.length <= 80, color: '#000', textBorderColor: '#fff', textBorderWidth: 2, fontWeight: 600, formatter: (p) => p.value[2].toFixed(1) },
+    visualMap: { dimension: 2, min: showU ? 0 : Math.floor(lo / 5) * 5, max: showU ? (hi > 0 ? hi : 1) : vals.length ? Math.ceil(hi / 5) * 5 : 100,
+      calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160, text: [showU ? 'u(η) %' : 'η %', ''], textStyle: { color: '#14181f' },
+      inRange: { color: showU ? ['#ffffe5', '#fee391', '#fe9929', '#cc4c02', '#662506'] : ['#313695', '#4575b4', '#74add1', '#abd9e9', '#fee090', '#fdae61', '#f46d43', '#a50026'] } },
+    series: [{ name: `${showU ? 'u of the efficiency' : 'efficiency'} ${cfgLabel(e)}`, type: 'heatmap', data,
+      label: { show: data.length <= 80, color: '#000', textBorderColor: '#fff', textBorderWidth: 2, fontWeight: 600, formatter: (p) => (showU ? fmtU(p.value[2]) : p.value[2].toFixed(1)) },
       emphasis: { itemStyle: { borderColor: '#000', borderWidth: 1 } } }],
+  };
+}
+
+// Efficiency at the ME angle against load, one line per speed, with its error bars (the map's cells).
+export function etaOption(analysis, cfg) {
+  const e = (analysis?.efficiency_map?.entries || []).find((x) => sameCfg(x, cfg)) || analysis?.efficiency_map?.entries?.[0];
+  if (!e) return { series: [] };
+  const series = [];
+  const bars = [];
+  e.speeds_rpm.forEach((s, i) => {
+    const color = PALETTE[i % PALETTE.length];
+    const pts = e.loads_Nm.map((l, j) => ({ x: l, y: e.efficiency[i]?.[j] == null ? null : e.efficiency[i][j] * 100,
+      u: known(e.efficiency_u?.[i]?.[j]) ? e.efficiency_u[i][j] * 100 : null })).filter((q) => q.y != null);
+    series.push({ name: `η ${s} rpm`, type: 'line', color, symbol: 'circle', symbolSize: 7, data: pts.map((q) => ({ value: [q.x, r2(q.y, 3)], u: q.u })) });
+    bars.push(errorBarSeries(`±2u η ${s} rpm`, color, pts));
+  });
+  series.push(...bars.filter(Boolean));
+  return {
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: series.filter((x) => !x.errorBars).map((x) => x.name) },
+    title: uNote(series),
+    grid: { left: 56, right: 16, top: 40, bottom: 40 },
+    tooltip: { trigger: 'axis', formatter: uTooltip(() => '%', () => 2) },
+    xAxis: axis('load torque T_L [N m]', { nameGap: 26 }),
+    yAxis: axis('efficiency η at ME [%]', { nameGap: 40 }),
+    series,
   };
 }
 
@@ -41,16 +83,22 @@ export function trajectoriesOption(analysis, cfg) {
   }
   const speeds = [...new Set(curves.map((c) => c.speed_rpm))].sort((a, b) => a - b);
   const series = [];
+  const bars = []; // after every line: the keyboard reader walks the lines first
   speeds.forEach((s, k) => {
     const cs = curves.filter((c) => c.speed_rpm === s).sort((a, b) => a.load_Nm - b.load_Nm);
     const color = PALETTE[k % PALETTE.length];
-    series.push({ name: `MTPA ${s} rpm`, type: 'line', color, symbol: 'circle', symbolSize: 7, data: cs.map((c) => [c.load_Nm, r2(c.mtpa?.angle_deg)]) });
-    series.push({ name: `ME ${s} rpm`, type: 'line', color, symbol: 'diamond', symbolSize: 8, lineStyle: { type: 'dashed' }, data: cs.map((c) => [c.load_Nm, r2(c.me?.angle_deg)]) });
+    const pt = (c, o, uk) => ({ value: [c.load_Nm, r2(c[o]?.angle_deg)], u: c[uk] ?? null });
+    series.push({ name: `MTPA ${s} rpm`, type: 'line', color, symbol: 'circle', symbolSize: 7, data: cs.map((c) => pt(c, 'mtpa', 'mtpa_angle_u_deg')) });
+    series.push({ name: `ME ${s} rpm`, type: 'line', color, symbol: 'diamond', symbolSize: 8, lineStyle: { type: 'dashed' }, data: cs.map((c) => pt(c, 'me', 'me_angle_u_deg')) });
+    bars.push(errorBarSeries(`±2u MTPA ${s} rpm`, color, cs.map((c) => ({ x: c.load_Nm, y: c.mtpa?.angle_deg, u: c.mtpa_angle_u_deg }))));
+    bars.push(errorBarSeries(`±2u ME ${s} rpm`, color, cs.map((c) => ({ x: c.load_Nm, y: c.me?.angle_deg, u: c.me_angle_u_deg }))));
   });
+  series.push(...bars.filter(Boolean));
   return {
-    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: series.filter((x) => !x.errorBars).map((x) => x.name) },
+    title: uNote(series),
     grid: { left: 56, right: 16, top: 40, bottom: 40 },
-    tooltip: { trigger: 'axis', valueFormatter: (v) => (v == null ? '–' : `${v}°`) },
+    tooltip: { trigger: 'axis', formatter: uTooltip(() => '°', () => 2) },
     xAxis: axis('load torque T_L [N m]', { nameGap: 26 }),
     yAxis: axis('current angle θ_i [deg]', { nameGap: 36 }),
     series,
@@ -62,6 +110,7 @@ export function trajectoriesOption(analysis, cfg) {
 export function curveOption(points, analysis, speed, load, configs) {
   const at = points.filter((p) => p.speed_rpm === speed && p.load_Nm === load);
   const series = [];
+  const bars = [];
   configs.forEach((cfg, k) => {
     const rs = at.filter((p) => sameCfg(p, cfg)).sort((a, b) => a.angle_deg - b.angle_deg);
     if (!rs.length) return;
@@ -70,12 +119,17 @@ export function curveOption(points, analysis, speed, load, configs) {
     const mark = (o, axisName) => (o ? { symbol: 'pin', symbolSize: 36, label: { fontSize: 10, color: '#fff' },
       data: [{ name: axisName, coord: [r2(o.angle_deg), r2(axisName === 'MTPA' ? o.im_A : o.pdcm_W, 3)], value: axisName }] } : undefined);
     series.push({ name: `I_m ${cfgLabel(cfg)}`, type: 'line', color, yAxisIndex: 0, symbol: 'circle', symbolSize: 6,
-      data: rs.map((p) => [p.angle_deg, r2(p.im_A, 4)]), markPoint: mark(c?.mtpa, 'MTPA') });
+      data: rs.map((p) => ({ value: [p.angle_deg, r2(p.im_A, 4)], u: p.im_u_A ?? null })), markPoint: mark(c?.mtpa, 'MTPA') });
     series.push({ name: `P_dcM ${cfgLabel(cfg)}`, type: 'line', color, yAxisIndex: 1, symbol: 'rect', symbolSize: 6, lineStyle: { type: 'dashed' },
-      data: rs.map((p) => [p.angle_deg, r2(p.pdcm_W, 2)]), markPoint: mark(c?.me, 'ME') });
+      data: rs.map((p) => ({ value: [p.angle_deg, r2(p.pdcm_W, 2)], u: p.pdcm_u_W ?? null })), markPoint: mark(c?.me, 'ME') });
+    bars.push(errorBarSeries(`±2u I_m ${cfgLabel(cfg)}`, color, rs.map((p) => ({ x: p.angle_deg, y: p.im_A, u: p.im_u_A })), { yAxisIndex: 0 }));
+    bars.push(errorBarSeries(`±2u P_dcM ${cfgLabel(cfg)}`, color, rs.map((p) => ({ x: p.angle_deg, y: p.pdcm_W, u: p.pdcm_u_W })), { yAxisIndex: 1 }));
   });
+  series.push(...bars.filter(Boolean));
   return {
-    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: series.filter((x) => !x.errorBars).map((x) => x.name) },
+    title: uNote(series),
+    tooltip: { trigger: 'axis', formatter: uTooltip((p) => (p.seriesName.startsWith('I_m') ? 'A' : 'W'), (p) => (p.seriesName.startsWith('I_m') ? 4 : 2)) },
     grid: { left: 56, right: 60, top: 40, bottom: 40 },
     xAxis: axis('current angle θ_i [deg]', { nameGap: 26 }),
     yAxis: [axis('I_m [A] (solid)', { nameGap: 40 }), axis('P_dcM [W] (dashed)', { nameGap: 44, splitLine: { show: false } })],
@@ -117,18 +171,34 @@ export function deltaOption(analysis) {
   for (const e of es) if (!cfgs.some((c) => sameCfg(c, e))) cfgs.push({ estimator: e.estimator, pwm: e.pwm });
   const cats = keys.map((k) => { const [s, l] = k.split('|'); return `${s} rpm\n${l} N m`; });
   const series = [];
+  const bars = [];
   cfgs.forEach((cfg, k) => {
     const color = PALETTE[(k + 1) % PALETTE.length];
-    const val = (f, o) => keys.map((key) => { const e = es.find((x) => sameCfg(x, cfg) && `${x.speed_rpm}|${x.load_Nm}` === key); return e ? r2(e[o]?.[f], 4) : null; });
-    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 0, yAxisIndex: 0, data: val('delta_im_A', 'mtpa') });
-    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 1, yAxisIndex: 1, data: val('delta_pdcm_W', 'me') });
+    const entry = (key) => es.find((x) => sameCfg(x, cfg) && `${x.speed_rpm}|${x.load_Nm}` === key);
+    // a bar whose difference is not significant at 95 % is faded and hatched (data-significant="false" in the tooltip)
+    const val = (f, o, uf, sf) => keys.map((key) => {
+      const d = entry(key)?.[o];
+      if (d?.[f] == null) return null;
+      const sig = d[sf] ?? null;
+      return { value: r2(d[f], 4), u: d[uf] ?? null, significant: sig,
+        itemStyle: sig === false ? { opacity: 0.35, decal: { symbol: 'rect', dashArrayX: [1, 0], dashArrayY: [2, 4], rotation: Math.PI / 4, color: 'rgba(0,0,0,0.45)' } } : undefined };
+    });
+    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 0, yAxisIndex: 0, data: val('delta_im_A', 'mtpa', 'delta_im_u_A', 'delta_im_significant') });
+    series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 1, yAxisIndex: 1, data: val('delta_pdcm_W', 'me', 'delta_pdcm_u_W', 'delta_pdcm_significant') });
+    const slot = { k, n: cfgs.length };
+    const eb = (o, f, uf) => keys.map((key, i) => ({ x: i, y: entry(key)?.[o]?.[f], u: entry(key)?.[o]?.[uf] }));
+    bars.push(errorBarSeries(`±2u ΔI_m ${cfgLabel(cfg)}`, '#14181f', eb('mtpa', 'delta_im_A', 'delta_im_u_A'), { slot }));
+    bars.push(errorBarSeries(`±2u ΔP_dcM ${cfgLabel(cfg)}`, '#14181f', eb('me', 'delta_pdcm_W', 'delta_pdcm_u_W'), { slot, xAxisIndex: 1, yAxisIndex: 1 }));
   });
+  series.push(...bars.filter(Boolean));
   const ref = analysis?.deltas?.reference;
+  const anyInsignificant = series.some((x) => x.type === 'bar' && x.data.some((d) => d?.significant === false));
   return {
-    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' } },
-    title: ref ? { text: `vs ${cfgLabel(ref)}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } } : undefined,
-    tooltip: { trigger: 'axis' },
-    grid: [{ left: 60, right: 16, top: 40, height: '30%' }, { left: 60, right: 16, bottom: 44, height: '30%' }],
+    legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: series.filter((x) => !x.errorBars).map((x) => x.name) },
+    title: [ref ? { text: `vs ${cfgLabel(ref)}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } } : undefined,
+      { ...uNote(series, anyInsignificant ? ' · faded, hatched: not significant at 95 %' : ''), bottom: undefined, top: 18 }].filter(Boolean),
+    tooltip: { trigger: 'axis', formatter: uTooltip((p) => (p.seriesIndex % 2 === 0 ? 'A' : 'W'), () => 4) },
+    grid: [{ left: 60, right: 16, top: 48, height: '30%' }, { left: 60, right: 16, bottom: 44, height: '30%' }],
     xAxis: [{ type: 'category', data: cats, gridIndex: 0, axisLabel: { show: false } },
       { type: 'category', data: cats, gridIndex: 1, axisLabel: { color: '#333b47', fontSize: 10 } }],
     // bars start at zero

@@ -2,7 +2,8 @@
 import { api, download, saveBlob, getToken } from '../api.js';
 import { ChartCard } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
-import { effMapOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
+import { effMapOption, etaOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
+import { uncertaintyNote } from '../uncertainty_note.js';
 import { escapeHtml } from './live.js';
 import { ResultTables } from './tables.js';
 import { Compare } from './compare.js';
@@ -15,7 +16,7 @@ const key = (c) => `${c.estimator}/${c.pwm}`;
 // #/results/A/vs/B: the sweep compared with A (main.js's route passes A only)
 const vsFromHash = () => Number(/^#\/results\/\d+\/vs\/(\d+)/.exec(location.hash)?.[1]) || null;
 // file-name part of each card's titled PNG export
-const FIGURE = { map: 'efficiency-map', traj: 'mtpa-me-angle', curve: 'im-pdcm-vs-angle', poserr: 'position-error', delta: 'delta-vs-reference', hist: 'histograms' };
+const FIGURE = { map: 'efficiency-map', eta: 'efficiency-vs-load', traj: 'mtpa-me-angle', curve: 'im-pdcm-vs-angle', poserr: 'position-error', delta: 'delta-vs-reference', hist: 'histograms' };
 
 export class ResultsView {
   constructor(app) {
@@ -23,6 +24,7 @@ export class ResultsView {
     this.cards = {
       map: new ChartCard($('[data-chart="r-map"]'), { title: 'Efficiency map P_m / P_dcM at the ME angle' }),
       contour: new ChartCard($('[data-chart="r-contour"]'), { title: 'Efficiency contours (interpolated, iso-η lines)' }),
+      eta: new ChartCard($('[data-chart="r-eta"]'), { title: 'Efficiency at the ME angle against load' }),
       traj: new ChartCard($('[data-chart="r-traj"]'), { title: 'MTPA and ME angle against load (Fig. 6.20)' }),
       curve: new ChartCard($('[data-chart="r-curve"]'), { title: 'I_m and P_dcM against angle' }),
       poserr: new ChartCard($('[data-chart="r-poserr"]'), { title: 'Position error against load (Figs. 6.13-6.15)' }),
@@ -38,6 +40,13 @@ export class ResultsView {
         this.sweepName(this.sweepId), (app.sweeps || []).find((s) => s.id === this.sweepId));
     }
     this.tables = new ResultTables($('#r-tables'));
+    // The map or the map of its uncertainty u (where the map is uncertain).
+    this.showU = false;
+    const uBtn = document.createElement('button');
+    Object.assign(uBtn, { type: 'button', className: 'small', id: 'r-map-u', textContent: 'map of u', title: 'Show the standard uncertainty u of η per cell instead of η' });
+    uBtn.setAttribute('aria-pressed', 'false');
+    uBtn.addEventListener('click', () => { this.showU = !this.showU; uBtn.setAttribute('aria-pressed', String(this.showU)); uBtn.textContent = this.showU ? 'map of η' : 'map of u'; this.draw(); });
+    this.cards.map.h.parentElement.append(uBtn); // after PNG: "header button" stays the export
     app.resultsView = this; // window.synbench.resultsView: the end-to-end tests read the charts' options
     this.compare = new Compare(this, $('#r-compare'));
     app.on('sweeps', (list) => this.fillSweeps(list));
@@ -114,6 +123,7 @@ export class ResultsView {
       const p = analysis.points || {};
       $('#r-summary').textContent = `Sweep #${id}: ${p.records ?? points.length} points, ${p.used ?? '?'} used`
         + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`;
+      $('#r-unote').textContent = uncertaintyNote(points, analysis);
     } catch (e) {
       $('#r-summary').textContent = `cannot load sweep ${id}: ${e.message}`;
     }
@@ -161,8 +171,10 @@ export class ResultsView {
     const a = this.analysis;
     const speed = Number($('#r-speed').value);
     const load = Number($('#r-load').value);
-    this.cards.map.set(effMapOption(a, cfg));
-    this.cards.map.h.textContent = `Efficiency map η = P_m / P_dcM at the ME angle, ${cfgLabel(cfg)}`;
+    this.cards.map.set(effMapOption(a, cfg, this.showU), { empty: this.showU ? 'no uncertainty stored' : 'no data yet' });
+    this.cards.map.h.textContent = `${this.showU ? 'Standard uncertainty u of the efficiency map' : 'Efficiency map η = P_m / P_dcM'} at the ME angle, ${cfgLabel(cfg)}`;
+    this.cards.eta.set(etaOption(a, cfg));
+    this.cards.eta.h.textContent = `Efficiency η at the ME angle against load, ${cfgLabel(cfg)}`;
     drawContours(this.cards.contour, a, cfg, cfgLabel(cfg));
     this.cards.traj.set(trajectoriesOption(a, cfg));
     this.cards.traj.h.textContent = `MTPA (solid) and ME (dashed) angle against load, ${cfgLabel(cfg)}`;

@@ -1,16 +1,22 @@
-// Numeric tables of the Results view: the MTPA and ME optima per configuration x speed x load,
-// and the efficiency per load x speed of the chosen configuration, each with a "Copy CSV"
-// button. The values are the analysis document's (GET /api/sweeps/{id}/analysis), printed at a
+// Numeric tables of the Results view: the MTPA and ME optima per configuration x speed x load
+// (each value with its standard uncertainty u, k = 1, and the ME - MTPA difference with whether it
+// is significant at 95 %), and the efficiency per load x speed of the chosen configuration with
+// its u, each with a "Copy CSV" button. The values are the analysis document's (GET /api/sweeps/{id}/analysis), printed at a
 // fixed precision; the CSV carries them unrounded.
 import { saveBlob } from '../api.js';
 import { analysisConfigs } from '../analysis_configs.js';
 import { cfgLabel, sameCfg } from './plots.js';
 import { escapeHtml } from './live.js';
+import { fmtU, known } from '../errorbars.js';
 
 // A cell: {v: the value for the CSV, t: the text shown}.
 export const fmt = (v, d) => (v == null || !Number.isFinite(v) ? '–' : v.toFixed(d));
 export const numCell = (v, d) => ({ v: v == null || !Number.isFinite(v) ? '' : v, t: fmt(v, d) });
 export const textCell = (s) => ({ v: s, t: s });
+// A standard uncertainty (k = 1), two significant digits; scale: e.g. 100 for %.
+export const uCell = (u, scale = 1) => (known(u) ? { v: u * scale, t: fmtU(u * scale) } : { v: '', t: '–' });
+// Significant at 95 %: true, false, or unknown (null: never a false "significant").
+export const sigCell = (s) => textCell(s === true ? 'yes' : s === false ? 'no' : '–');
 const pct = (v) => (v == null ? null : v * 100);
 const note = (o) => (o ? [o.at_edge ? 'at edge' : '', o.refined ? 'refined' : ''].filter(Boolean).join(', ') : '');
 
@@ -66,13 +72,17 @@ export function optimaModel(analysis) {
   const idx = (c) => order.findIndex((o) => sameCfg(o, c));
   const es = (analysis?.curves?.entries || []).slice()
     .sort((a, b) => idx(a) - idx(b) || a.speed_rpm - b.speed_rpm || a.load_Nm - b.load_Nm);
-  const opt = (o) => [numCell(o?.angle_deg, 2), numCell(o?.im_A, 3), numCell(o?.pdcm_W, 1), numCell(pct(o?.efficiency), 1), textCell(note(o))];
+  // every value followed by its standard uncertainty u (k = 1)
+  const opt = (o, uAngle) => [numCell(o?.angle_deg, 2), uCell(uAngle), numCell(o?.im_A, 3), uCell(o?.im_u_A), numCell(o?.pdcm_W, 1), uCell(o?.pdcm_u_W),
+    numCell(pct(o?.efficiency), 1), uCell(o?.efficiency_u, 100), textCell(note(o))];
+  const head = (t) => [`${t} angle [deg]`, `${t} angle ±u [deg]`, `${t} I_m [A]`, `${t} I_m ±u [A]`, `${t} P_dcM [W]`, `${t} P_dcM ±u [W]`,
+    `${t} η [%]`, `${t} η ±u [%]`, `${t} note`];
   return {
-    head: ['configuration', 'speed [rpm]', 'load [N m]',
-      'MTPA angle [deg]', 'MTPA I_m [A]', 'MTPA P_dcM [W]', 'MTPA η [%]', 'MTPA note',
-      'ME angle [deg]', 'ME I_m [A]', 'ME P_dcM [W]', 'ME η [%]', 'ME note'],
+    head: ['configuration', 'speed [rpm]', 'load [N m]', ...head('MTPA'), ...head('ME'),
+      'ME − MTPA [deg]', 'ME − MTPA ±u [deg]', 'ME − MTPA significant at 95 %'],
     rowHead: 3,
-    rows: es.map((e) => [textCell(cfgLabel(e)), numCell(e.speed_rpm, 0), numCell(e.load_Nm, 2), ...opt(e.mtpa), ...opt(e.me)]),
+    rows: es.map((e) => [textCell(cfgLabel(e)), numCell(e.speed_rpm, 0), numCell(e.load_Nm, 2), ...opt(e.mtpa, e.mtpa_angle_u_deg), ...opt(e.me, e.me_angle_u_deg),
+      numCell(e.me_minus_mtpa_deg, 2), uCell(e.me_minus_mtpa_u_deg), sigCell(e.me_minus_mtpa_significant)]),
   };
 }
 
@@ -81,8 +91,8 @@ export function efficiencyModel(analysis, cfg) {
   const e = (analysis?.efficiency_map?.entries || []).find((x) => sameCfg(x, cfg));
   if (!e) return { head: ['load [N m]'], rows: [] };
   return {
-    head: ['load [N m]', ...e.speeds_rpm.map((s) => `η [%] at ${s} rpm`)],
-    rows: e.loads_Nm.map((l, j) => [numCell(l, 2), ...e.speeds_rpm.map((s, i) => numCell(pct(e.efficiency[i]?.[j]), 1))]),
+    head: ['load [N m]', ...e.speeds_rpm.flatMap((s) => [`η [%] at ${s} rpm`, `±u [%] at ${s} rpm`])],
+    rows: e.loads_Nm.map((l, j) => [numCell(l, 2), ...e.speeds_rpm.flatMap((s, i) => [numCell(pct(e.efficiency[i]?.[j]), 1), uCell(e.efficiency_u?.[i]?.[j], 100)])]),
   };
 }
 
