@@ -11,6 +11,7 @@ namespace {
 
 constexpr double kW = 640, kH = 380, kLeft = 70, kRight = 150, kTop = 52, kBottom = 50;
 constexpr double kPlotW = kW - kLeft - kRight, kPlotH = kH - kTop - kBottom;
+constexpr double kCoverage = 2;  // error bars: +/- 2u (about 95 %)
 constexpr std::array<const char*, 8> kPalette = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
                                                  "#ff7f0e", "#17becf", "#8c564b", "#e377c2"};
 
@@ -131,34 +132,58 @@ std::string escape_xml(const std::string& text) {
 }
 
 std::string svg_xy(const XYPlot& p) {
+  const auto u_of = [](const XYSeries& s, std::size_t i) { return i < s.u.size() && std::isfinite(s.u[i]) ? s.u[i] : std::nan(""); };
   Range x, y;
   for (const auto& s : p.series)
-    for (const auto& pt : s.points)
-      if (std::isfinite(pt[1])) x.add(pt[0]), y.add(pt[1]);
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const auto& pt = s.points[i];
+      if (!std::isfinite(pt[1])) continue;
+      x.add(pt[0]), y.add(pt[1]);
+      if (const double u = u_of(s, i); std::isfinite(u)) y.add(pt[1] - kCoverage * u), y.add(pt[1] + kCoverage * u);
+    }
   x.settle();
   y.settle();
   const auto xt = ticks(x), yt = ticks(y);
   std::string out = open_svg(p.title) + axes(x, y, p.x_label, p.y_label, xt, yt);
+  const auto Yof = [&](double v) { return kTop + kPlotH - (v - y.lo) / (y.hi - y.lo) * kPlotH; };
   for (std::size_t k = 0; k < p.series.size(); ++k) {
     const auto& s = p.series[k];
     const char* c = kPalette[k % kPalette.size()];
     std::string path, marks;
     bool pen = false;
-    for (const auto& pt : s.points) {
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const auto& pt = s.points[i];
       if (!std::isfinite(pt[0]) || !std::isfinite(pt[1])) {
         pen = false;
         continue;
       }
       const double X = kLeft + (pt[0] - x.lo) / (x.hi - x.lo) * kPlotW;
-      const double Y = kTop + kPlotH - (pt[1] - y.lo) / (y.hi - y.lo) * kPlotH;
+      const double Y = Yof(pt[1]);
       path += (pen ? "L" : "M") + px(X) + " " + px(Y);
       pen = true;
-      marks += "<circle cx=\"" + px(X) + "\" cy=\"" + px(Y) + "\" r=\"2.5\"/>";
+      const bool hollow = i < s.hollow.size() && s.hollow[i];
+      marks += "<circle cx=\"" + px(X) + "\" cy=\"" + px(Y) + (hollow ? "\" r=\"3.5\" fill=\"#fff\" class=\"insignificant\"/>" : "\" r=\"2.5\"/>");
+      if (const double u = u_of(s, i); std::isfinite(u)) {
+        const double lo = Yof(pt[1] - kCoverage * u), hi = Yof(pt[1] + kCoverage * u);
+        marks += "<line class=\"eb\" data-u=\"" + num(u, 9) + "\" x1=\"" + px(X) + "\" y1=\"" + px(lo) + "\" x2=\"" + px(X) + "\" y2=\"" + px(hi) +
+                 "\"/><line x1=\"" + px(X - 3) + "\" y1=\"" + px(lo) + "\" x2=\"" + px(X + 3) + "\" y2=\"" + px(lo) + "\"/><line x1=\"" + px(X - 3) +
+                 "\" y1=\"" + px(hi) + "\" x2=\"" + px(X + 3) + "\" y2=\"" + px(hi) + "\"/>";
+      }
     }
     out += "<g stroke=\"" + std::string(c) + "\" fill=\"" + c + "\"><path d=\"" + path + "\" fill=\"none\" stroke-width=\"1.6\"" +
            (s.dashed ? " stroke-dasharray=\"5 3\"" : "") + "/>" + marks + "</g>";
     if (k < 18) out += legend_entry(k, s.name, c, s.dashed);
   }
+  // the note's lines ('\n') in the legend's column, above the plot's bottom
+  std::vector<std::string> lines;
+  for (std::size_t from = 0; !p.note.empty() && from <= p.note.size();) {
+    const auto to = std::min(p.note.find('\n', from), p.note.size());
+    lines.push_back(p.note.substr(from, to - from));
+    from = to + 1;
+  }
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    out += "<text x=\"" + px(kW - kRight + 10) + "\" y=\"" + px(kTop + kPlotH - 14 * static_cast<double>(lines.size() - 1 - i)) +
+           "\" class=\"note\">" + escape_xml(lines[i]) + "</text>";
   return out + "</svg>";
 }
 

@@ -14,12 +14,18 @@ struct XYSeries {
   std::string name;
   std::vector<std::array<double, 2>> points;  // {x, y}, drawn in order; gaps where y is NaN
   bool dashed = false;
+  // Parallel to points (or empty): the standard uncertainty u (k = 1) of y, drawn as an error bar
+  // of +/- 2u (about 95 %); NaN: none. hollow: the point's difference is not significant at 95 %.
+  std::vector<double> u = {};
+  std::vector<bool> hollow = {};
 };
 struct XYPlot {
   std::string title, x_label, y_label;
   std::vector<XYSeries> series;
+  std::string note = {};  // under the legend, e.g. "bars: ±2u, 95 %"
 };
 // A line plot with markers, axes with "nice" ticks and a legend; colours from one palette.
+// Error bars are <line class="eb" data-u="u"> (the report test reads them back).
 std::string svg_xy(const XYPlot& p);
 
 struct Bar {

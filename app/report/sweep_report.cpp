@@ -13,9 +13,11 @@
 #include <map>
 #include <set>
 
+#include "app/report/report_uncertainty.hpp"
 #include "app/report/svg_plot.hpp"
 #include "bench/efficiency_grid.hpp"
 #include "db/export.hpp"
+#include "drivers/json.hpp"
 #include "synbench/version.hpp"
 
 namespace synbench::report {
@@ -40,6 +42,7 @@ bool same(double a, double b) { return std::fabs(a - b) < 1e-6; }
 
 struct Page {
   const ReportInput& in;
+  const synbench::Json& json;  // the analysis as JSON: its uncertainty keys (report_uncertainty.hpp)
   std::string body;
   std::size_t figures = 0;
 
@@ -53,8 +56,26 @@ struct Page {
   }
 };
 
+// The note of a figure with error bars: what they are, or that there is no u to draw.
+std::string bars_note(const std::vector<XYSeries>& series, bool hollow) {
+  const bool any = std::any_of(series.begin(), series.end(),
+                               [](const XYSeries& s) { return std::any_of(s.u.begin(), s.u.end(), [](double u) { return std::isfinite(u); }); });
+  return any ? std::string("bars: ±2u, 95 %") + (hollow ? "\nhollow: not significant\nat 95 %" : "") : "no uncertainty stored";
+}
+const synbench::Json& entry(const synbench::Json& j, const char* section, std::size_t i) {
+  static const synbench::Json kNull;
+  const auto s = j.find(section);
+  if (s == j.end() || !s->contains("entries") || i >= (*s)["entries"].size()) return kNull;
+  return (*s)["entries"][i];
+}
+double u_of(const std::optional<double>& u) { return u.value_or(std::nan("")); }
+
 void figures_of(Page& p, const Configuration& cfg) {
   const auto& a = p.in.analysis;
+  // the analysis JSON entry of a curve or delta (to_json keeps the order of a.curves and a.deltas)
+  const auto curve_json = [&](const bench::CurveResult* c) -> const synbench::Json& {
+    return entry(p.json, "curves", static_cast<std::size_t>(c - a.curves.data()));
+  };
   // Efficiency map as measured, and interpolated with iso-lines.
   for (const auto& c : a.efficiency_contours) {
     if (!(c.configuration == cfg)) continue;
@@ -94,10 +115,13 @@ void figures_of(Page& p, const Configuration& cfg) {
         if (same(c->speed_rpm, s)) {
           mtpa.points.push_back({c->load_Nm, c->mtpa.angle_deg});
           me.points.push_back({c->load_Nm, c->me.angle_deg});
+          mtpa.u.push_back(json_number(curve_json(c), "mtpa_angle_u_deg"));
+          me.u.push_back(json_number(curve_json(c), "me_angle_u_deg"));
         }
       t.series.push_back(std::move(mtpa));
       t.series.push_back(std::move(me));
     }
+    t.note = bars_note(t.series, false);
     p.figure(svg_xy(t));
   }
   std::set<std::size_t> excluded;
@@ -119,10 +143,14 @@ void figures_of(Page& p, const Configuration& cfg) {
       for (const auto* r : pts) {
         a1.points.push_back({r->angle_deg, r->im_A});
         a2.points.push_back({r->angle_deg, r->pdcm_W});
+        a1.u.push_back(u_of(r->im_u_A));
+        a2.u.push_back(u_of(r->pdcm_u_W));
       }
       im.series.push_back(std::move(a1));
       pd.series.push_back(std::move(a2));
     }
+    im.note = bars_note(im.series, false);
+    pd.note = bars_note(pd.series, false);
     p.figure(svg_xy(im));
     p.figure(svg_xy(pd));
   }
@@ -151,15 +179,25 @@ void figures_of(Page& p, const Configuration& cfg) {
             "load torque T_L [N m]", "ΔP_dcM [W]", {}};
   for (double s : speeds) {
     XYSeries x1{shortest(s) + " rpm", {}, false}, x2 = x1;
-    for (const auto& d : a.deltas)
-      if (d.configuration == cfg && same(d.speed_rpm, s)) {
-        x1.points.push_back({d.load_Nm, d.mtpa.delta_im_A});
-        x2.points.push_back({d.load_Nm, d.me.delta_pdcm_W});
-      }
+    for (std::size_t i = 0; i < a.deltas.size(); ++i) {
+      const auto& d = a.deltas[i];
+      if (!(d.configuration == cfg && same(d.speed_rpm, s))) continue;
+      const auto& j = entry(p.json, "deltas", i);
+      const auto& jm = j.is_object() && j.contains("mtpa") ? j["mtpa"] : j;
+      const auto& je = j.is_object() && j.contains("me") ? j["me"] : j;
+      x1.points.push_back({d.load_Nm, d.mtpa.delta_im_A});
+      x2.points.push_back({d.load_Nm, d.me.delta_pdcm_W});
+      x1.u.push_back(json_number(jm, "delta_im_u_A"));
+      x2.u.push_back(json_number(je, "delta_pdcm_u_W"));
+      x1.hollow.push_back(json_bool(jm, "delta_im_significant") == std::optional<bool>(false));
+      x2.hollow.push_back(json_bool(je, "delta_pdcm_significant") == std::optional<bool>(false));
+    }
     if (x1.points.empty()) continue;
     di.series.push_back(std::move(x1));
     dp.series.push_back(std::move(x2));
   }
+  di.note = bars_note(di.series, true);
+  dp.note = bars_note(dp.series, true);
   if (!di.series.empty()) {
     p.figure(svg_xy(di));
     p.figure(svg_xy(dp));
@@ -188,6 +226,7 @@ figure{margin:1em 0}svg.plot{width:100%;max-width:860px;height:auto;font:11px sa
 svg .t{font-size:13px;font-weight:600}svg .l{font-weight:600}svg .g{stroke:#e3e6eb}svg .f{fill:none;stroke:#333b47}
 svg .v{font-size:10px;fill:#000;paint-order:stroke;stroke:#fff;stroke-width:2px}
 svg .iso-label{font-size:11px;font-weight:700;paint-order:stroke;stroke:#fff;stroke-width:3px}
+svg .note{font-size:10px;fill:#4a5361}svg .eb{stroke-width:1.2}
 )";
 
 }  // namespace
@@ -209,7 +248,8 @@ std::string report_base_name(const db::Sweep& sweep, const std::string& generate
 std::string render_report(const ReportInput& in) {
   const auto& s = in.sweep;
   const auto& a = in.analysis;
-  Page p{in, {}, 0};
+  const synbench::Json json = bench::to_json(a);
+  Page p{in, json, {}, 0};
   const std::string name = "Sweep #" + std::to_string(s.id) + " '" + s.meta.name + "'";
   std::string& b = p.body;
   b += "<h1>" + escape_xml(name) + "</h1>\n<p class=\"generated\">Report generated <time>" + escape_xml(in.context.generated_at) +
@@ -238,6 +278,7 @@ std::string render_report(const ReportInput& in) {
   std::vector<Configuration> configs;
   for (const auto& c : a.curves)
     if (std::find(configs.begin(), configs.end(), c.configuration) == configs.end()) configs.push_back(c.configuration);
+  b += uncertainty_section(json, in.rows);
   b += "\n<h2 id=\"figures\">Figures</h2>\n";
   if (configs.empty()) b += "<p>No point of this sweep is usable: nothing to draw.</p>";
   for (const auto& cfg : configs) {
@@ -248,15 +289,26 @@ std::string render_report(const ReportInput& in) {
   b += "\n<h2 id=\"tables\">Tables</h2>\n<h3>MTPA and ME optima per configuration, speed and load</h3>\n"
        "<table id=\"optima\"><thead><tr><th>estimator</th><th>pwm</th><th>speed_rpm</th><th>load_Nm</th><th>points</th>"
        "<th>MTPA angle_deg</th><th>MTPA im_A</th><th>MTPA pdcm_W</th><th>MTPA efficiency</th>"
-       "<th>ME angle_deg</th><th>ME im_A</th><th>ME pdcm_W</th><th>ME efficiency</th></tr></thead><tbody>";
+       "<th>ME angle_deg</th><th>ME im_A</th><th>ME pdcm_W</th><th>ME efficiency</th>"
+       "<th>MTPA angle_u_deg</th><th>MTPA im_u_A</th><th>ME angle_u_deg</th><th>ME pdcm_u_W</th><th>ME efficiency_u</th>"
+       "<th>me_minus_mtpa_deg</th><th>me_minus_mtpa_u_deg</th><th>ME − MTPA significant at 95 %</th></tr></thead><tbody>";
   const auto opt = [](const bench::CurveOptimum& o) {
     return td(fixed(o.angle_deg, 2)) + td(fixed(o.im_A, 3)) + td(fixed(o.pdcm_W, 1)) +
            td(o.pdcm_W > 0 ? fixed(o.efficiency, 4) : "–");
   };
-  for (const auto& c : a.curves)
+  for (std::size_t i = 0; i < a.curves.size(); ++i) {
+    const auto& c = a.curves[i];
+    const auto& j = entry(json, "curves", i);
+    const auto& jm = j.is_object() && j.contains("mtpa") ? j["mtpa"] : j;
+    const auto& je = j.is_object() && j.contains("me") ? j["me"] : j;
     b += "<tr>" + td(std::string(drivers::name(c.configuration.estimator))) + td(std::string(drivers::name(c.configuration.pwm))) +
-         td(shortest(c.speed_rpm)) + td(shortest(c.load_Nm)) + td(std::to_string(c.points)) + opt(c.mtpa) + opt(c.me) + "</tr>";
-  b += "</tbody></table>\n";
+         td(shortest(c.speed_rpm)) + td(shortest(c.load_Nm)) + td(std::to_string(c.points)) + opt(c.mtpa) + opt(c.me) +
+         td(u_text(json_number(j, "mtpa_angle_u_deg"))) + td(u_text(json_number(jm, "im_u_A"))) +
+         td(u_text(json_number(j, "me_angle_u_deg"))) + td(u_text(json_number(je, "pdcm_u_W"))) + td(u_text(json_number(je, "efficiency_u"))) +
+         td(fixed(json_number(j, "me_minus_mtpa_deg"), 2)) + td(u_text(json_number(j, "me_minus_mtpa_u_deg"))) +
+         td(significance_text(json_bool(j, "me_minus_mtpa_significant"))) + "</tr>";
+  }
+  b += "</tbody></table>\n" + deltas_table(json);
   for (const auto& cfg : configs) {
     const auto grid = bench::measured_efficiency_grid(a.efficiency, cfg);
     b += "<h3>Efficiency at the ME angle, speed x load, " + escape_xml(label(cfg)) + "</h3>\n<table class=\"eta-grid\" data-estimator=\"" +
@@ -271,6 +323,7 @@ std::string render_report(const ReportInput& in) {
     }
     b += "</tbody></table>\n";
   }
+  b += efficiency_u_grids(json);
   b += "\n<h2 id=\"exclusions\">Exclusions</h2>\n";
   if (a.excluded.empty()) b += "<p>No point was left out.</p>";
   else {

@@ -1,6 +1,7 @@
 // The one-click report of a sweep (issue 25, docs/report.md): one self-contained HTML file with
-// the sweep, its plan, the bench and software metadata, every result figure as inline SVG, the
-// numeric tables and the exclusions; the points CSV goes beside it. Pure rendering: the caller
+// the sweep, its plan, the bench and software metadata, the uncertainty summary (issue 26), every
+// result figure as inline SVG (with +/- 2u error bars where the points carry u), the numeric tables
+// (with +/- u and significance) and the exclusions; the points CSV goes beside it. Pure rendering: the caller
 // reads the store (make_sweep_report does it for the CLI and the daemon alike).
 #pragma once
 

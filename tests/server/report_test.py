@@ -188,8 +188,8 @@ def main():
         want_cells = [str(c["points"])]
         for o in (c["mtpa"], c["me"]):
             want_cells += [fixed(o["angle_deg"], 2), fixed(o["im_A"], 3), fixed(o["pdcm_W"], 1), fixed(o["efficiency"], 4)]
-        check(row[4:] == want_cells, "optima of %s/%s %s rpm %s N m: %r == %r" %
-              (c["estimator"], c["pwm"], c["speed_rpm"], c["load_Nm"], row[4:], want_cells))
+        check(row[4:13] == want_cells, "optima of %s/%s %s rpm %s N m: %r == %r" %
+              (c["estimator"], c["pwm"], c["speed_rpm"], c["load_Nm"], row[4:13], want_cells))
     # The efficiency grids equal the efficiency map.
     grids = [t for t in p.tables if t["class"] == "eta-grid"]
     check(len(grids) == len(analysis["efficiency_map"]["entries"]), "one efficiency grid per configuration")

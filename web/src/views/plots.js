@@ -33,14 +33,14 @@ export function effMapOption(analysis, cfg, showU = false) {
     + `${known(p.data.ur) ? `<br>point-to-point part ${fmtU(p.data.ur * 100)} %` : ''}` : `${(p.data.eta * 100).toFixed(1)} % (${NO_U_NOTE})`}`;
   const lo = vals.length ? Math.min(...vals) : 0, hi = vals.length ? Math.max(...vals) : 100;
   return {
-    title: uNote(data.some((d) => d.u != null) ? [{ errorBars: true }] : [], showU ? ' · showing u [%]' : ''),
+    title: { ...uNote([]), text: !data.some((d) => d.u != null) ? NO_U_NOTE : showU ? 'u(η) per cell, percentage points (k=1)' : 'tooltip: η ± u (k=1)' },
     tooltip: { trigger: 'item', formatter: tip },
     grid: { left: 64, right: 80, top: 24, bottom: 40 },
     xAxis: { type: 'category', name: 'load torque T_L [N m]', nameLocation: 'middle', nameGap: 26, data: e.loads_Nm.map(String),
       axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
     yAxis: { type: 'category', name: 'speed [rpm]', nameLocation: 'middle', nameGap: 44, data: e.speeds_rpm.map(String),
       axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
-    visualMap: { dimension: 2, min: showU ? 0 : Math.floor(lo / 5) * 5, max: showU ? (hi > 0 ? hi : 1) : vals.length ? Math.ceil(hi / 5) * 5 : 100,
+    visualMap: { dimension: 2, precision: showU ? 2 : 0, min: showU ? 0 : Math.floor(lo / 5) * 5, max: showU ? (hi > 0 ? hi : 1) : vals.length ? Math.ceil(hi / 5) * 5 : 100,
       calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160, text: [showU ? 'u(η) %' : 'η %', ''], textStyle: { color: '#14181f' },
       inRange: { color: showU ? ['#ffffe5', '#fee391', '#fe9929', '#cc4c02', '#662506'] : ['#313695', '#4575b4', '#74add1', '#abd9e9', '#fee090', '#fdae61', '#f46d43', '#a50026'] } },
     series: [{ name: `${showU ? 'u of the efficiency' : 'efficiency'} ${cfgLabel(e)}`, type: 'heatmap', data,
