@@ -24,6 +24,10 @@ export function pm(v, u, unit = '', digits = 2) {
   return known(u) ? `${v.toFixed(digits)} ± ${fmtU(u)}${sp} (k=1)` : `${v.toFixed(digits)}${sp}`;
 }
 
+// The look of a bar whose difference is not significant at 95 %: faded and hatched.
+export const FADED = { opacity: 0.35, decal: { symbol: 'rect', dashArrayX: [1, 0], dashArrayY: [2, 4], rotation: Math.PI / 4, color: 'rgba(0,0,0,0.45)' } };
+export const FADED_NOTE = 'faded, hatched: not significant at 95 %';
+
 // Significance text of a difference: true, false or null (unknown: never a false "significant").
 export const sigText = (s) => (s === true ? 'significant at 95 %' : s === false ? 'not significant at 95 %' : 'unknown');
 

@@ -11,7 +11,7 @@ import { ChartCard, axis, PALETTE } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
 import { trajectoriesOption, curveOption, cfgLabel } from './plots.js';
 import { tableBlock, numCell, textCell, uCell, sigCell } from './tables.js';
-import { errorBarSeries, withoutBars, known, fmtU, sigText, BARS_NOTE, NO_U_NOTE } from '../errorbars.js';
+import { errorBarSeries, withoutBars, known, fmtU, sigText, BARS_NOTE, NO_U_NOTE, FADED, FADED_NOTE } from '../errorbars.js';
 import { keyboardPoints } from '../chart_keys.js';
 
 const ckey = (c) => `${c.estimator}/${c.pwm}`;
@@ -62,7 +62,6 @@ export function diffRuns(a, b) {
 function diffOption(rows, cfg, ida, idb) {
   const rs = rows.filter((r) => r.in === 'both' && ckey(r) === ckey(cfg));
   const cats = rs.map((r) => `${r.speed_rpm} rpm\n${r.load_Nm} N m`);
-  const FADED = { opacity: 0.35, decal: { symbol: 'rect', dashArrayX: [1, 0], dashArrayY: [2, 4], rotation: Math.PI / 4, color: 'rgba(0,0,0,0.45)' } };
   // f: the difference's field; its u is f with _u before the unit, its significance f's stem + _significant
   const uf = (f) => f.replace(/_(deg|pp|W)$/, '_u_$1');
   const sf = (f) => f.replace(/_(deg|pp|W)$/, '_significant');
@@ -80,7 +79,7 @@ function diffOption(rows, cfg, ida, idb) {
   return {
     legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: ['Δ MTPA angle', 'Δ ME angle', 'Δη at ME', 'ΔP_dcM at ME'] },
     title: [{ text: `#${idb} − #${ida}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
-      { text: bars.length ? `${BARS_NOTE}${faded ? ' · faded, hatched: not significant at 95 %' : ''}` : NO_U_NOTE, right: 8, top: 18, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
+      { text: bars.length ? `${BARS_NOTE}${faded ? ` · ${FADED_NOTE}` : ''}` : NO_U_NOTE, right: 8, top: 18, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } },
       panelTitle('Δ MTPA and Δ ME angle [deg]', 0), panelTitle('Δη at ME [percentage points]', 1), panelTitle('ΔP_dcM at ME [W]', 2)],
     tooltip: { trigger: 'axis', formatter: tip },
     grid,

@@ -1,7 +1,7 @@
 // ECharts options of the result plots, shared by the progress panel and the results view. Input
 // is the analysis JSON (docs/analysis.md) or the points JSON (docs/record.md).
 import { axis, PALETTE } from '../charts.js';
-import { errorBarSeries, pm, fmtU, known, sigText, BARS_NOTE, NO_U_NOTE } from '../errorbars.js';
+import { errorBarSeries, pm, fmtU, known, BARS_NOTE, NO_U_NOTE, FADED, FADED_NOTE } from '../errorbars.js';
 
 const r2 = (v, d = 2) => (v == null || !Number.isFinite(v) ? null : Number(v.toFixed(d)));
 export const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
@@ -12,7 +12,7 @@ export const uNote = (series, extra = '') => ({ text: series.some((s) => s?.erro
   right: 8, bottom: 0, textStyle: { fontSize: 11, fontWeight: 'normal', color: '#4a5361' } });
 // Axis tooltip lines "● name: value ± u unit (k=1)" of the series that are not error bars.
 const uTooltip = (unitOf, digits) => (params) => [].concat(params).filter((p) => p.seriesType !== 'custom' && p.value != null)
-  .map((p, k, all) => `${k === 0 ? `${Array.isArray(p.value) ? p.value[0] : p.name}<br>` : ''}${p.marker}${p.seriesName}: `
+  .map((p, k) => `${k === 0 ? `${Array.isArray(p.value) ? p.value[0] : p.name}<br>` : ''}${p.marker}${p.seriesName}: `
     + `${pm(Array.isArray(p.value) ? p.value[1] : p.value, p.data?.u, unitOf(p), digits(p))}${p.data?.significant === false ? ' — not significant at 95 %' : ''}`)
   .join('<br>');
 
@@ -181,7 +181,7 @@ export function deltaOption(analysis) {
       if (d?.[f] == null) return null;
       const sig = d[sf] ?? null;
       return { value: r2(d[f], 4), u: d[uf] ?? null, significant: sig,
-        itemStyle: sig === false ? { opacity: 0.35, decal: { symbol: 'rect', dashArrayX: [1, 0], dashArrayY: [2, 4], rotation: Math.PI / 4, color: 'rgba(0,0,0,0.45)' } } : undefined };
+        itemStyle: sig === false ? FADED : undefined };
     });
     series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 0, yAxisIndex: 0, data: val('delta_im_A', 'mtpa', 'delta_im_u_A', 'delta_im_significant') });
     series.push({ name: cfgLabel(cfg), type: 'bar', color, xAxisIndex: 1, yAxisIndex: 1, data: val('delta_pdcm_W', 'me', 'delta_pdcm_u_W', 'delta_pdcm_significant') });
@@ -196,7 +196,7 @@ export function deltaOption(analysis) {
   return {
     legend: { top: 0, type: 'scroll', textStyle: { color: '#14181f' }, data: series.filter((x) => !x.errorBars).map((x) => x.name) },
     title: [ref ? { text: `vs ${cfgLabel(ref)}`, right: 8, top: 0, textStyle: { fontSize: 11, color: '#4a5361', fontWeight: 'normal' } } : undefined,
-      { ...uNote(series, anyInsignificant ? ' · faded, hatched: not significant at 95 %' : ''), bottom: undefined, top: 18 }].filter(Boolean),
+      { ...uNote(series, anyInsignificant ? ` · ${FADED_NOTE}` : ''), bottom: undefined, top: 18 }].filter(Boolean),
     tooltip: { trigger: 'axis', formatter: uTooltip((p) => (p.seriesIndex % 2 === 0 ? 'A' : 'W'), () => 4) },
     grid: [{ left: 60, right: 16, top: 48, height: '30%' }, { left: 60, right: 16, bottom: 44, height: '30%' }],
     xAxis: [{ type: 'category', data: cats, gridIndex: 0, axisLabel: { show: false } },
