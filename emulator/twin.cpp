@@ -107,6 +107,8 @@ void Twin::step() {
     // wherever on the twin's clock the window starts.
     vfc_.open_gate(0.0);
     window_steps_ = window_left_;
+    const std::int64_t b = cfg_.firmware.window_batches;
+    batch_steps_ = window_steps_ >= b && window_steps_ % b == 0 ? window_steps_ / b : 0;
     t_pin_ = t_pcu_ = t_pfe_ = t_pmech_ = t_pinv_ = t_pm_ = t_temp_ = 0;
   }
 
@@ -183,6 +185,9 @@ void Twin::step() {
   ++steps_;
 
   if (window_left_ > 0) {
+    // The meter latches its counters at each sub-gate boundary (the drives' batch boundaries).
+    const std::int64_t done = window_steps_ - window_left_ + 1;
+    if (batch_steps_ > 0 && done % batch_steps_ == 0 && done < window_steps_) vfc_.end_batch();
     t_pin_ += 0.5 * (k1.pac_W + k2.pac_W);
     t_pcu_ += pcu;
     t_pfe_ += pfe;
@@ -201,6 +206,9 @@ void Twin::step() {
 
 void Twin::open_window(double window_s) {
   window_pending_ = std::max<std::int64_t>(1, std::llround(window_s / ts_));
+  // Whole batches: the drives, the meter's gate and the truth all last the rounded length.
+  const std::int64_t b = cfg_.firmware.window_batches;
+  if (window_pending_ >= b) window_pending_ = std::llround(static_cast<double>(window_pending_) / static_cast<double>(b)) * b;
   truth_.reset();
 }
 

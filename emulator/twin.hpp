@@ -63,7 +63,8 @@ class Twin {
   firmware::LoadDriveFirmware& load_drive() { return load_fw_; }
 
   // Opens one window on the drives, the meter and the truth accumulator, starting at the next
-  // period and lasting round(window_s / step) periods on all of them.
+  // period and lasting round(window_s / step) periods on all of them, rounded to a multiple of
+  // firmware.window_batches (from that many periods on) so its batches are equal.
   void open_window(double window_s);
   bool window_open() const { return window_pending_ > 0 || window_left_ > 0; }
   const drivers::MeterReading& meter_reading() const { return vfc_.reading(); }
@@ -108,6 +109,7 @@ class Twin {
   std::optional<McidcSample> mcidc_sample_;
 
   std::int64_t window_pending_ = 0, window_left_ = 0, window_steps_ = 0;
+  std::int64_t batch_steps_ = 0;  // periods per batch (0: the window keeps no batches)
   double t_pin_ = 0, t_pcu_ = 0, t_pfe_ = 0, t_pmech_ = 0, t_pinv_ = 0, t_pm_ = 0, t_temp_ = 0;
   std::optional<drivers::TruthWindow> truth_;
 };

@@ -125,6 +125,9 @@ struct FirmwareParams {
   double lock_guard_s = 0.05;
   double lock_guard_current_A = 5.0;  // or a current vector this large (0: off)
   double telemetry_filter_s = 0.05;
+  // Equal consecutive sub-windows (batches) a measurement window's means are also kept over, on
+  // both drives and the VFC meter: the bench's type A uncertainty comes from their scatter.
+  int window_batches = 10;
   double max_speed_rpm = 1500.0;
   double overspeed_trip_rpm = 1800.0;
   double overcurrent_trip_A = 6.0;

@@ -155,6 +155,8 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.num("firmware.lock_guard_current_A", &f.lock_guard_current_A, 0, 100, "assumed",
         "lock guard: or a current vector above this, sensorless (0: off)", A);
   b.pos("firmware.telemetry_filter_s", &f.telemetry_filter_s, "assumed", "time constant of telemetry low-pass filters", A);
+  b.integer("firmware.window_batches", &f.window_batches, 2, 64, "assumed",
+            "equal sub-windows (batches) a window's means and the meter's counts are also kept over (type A uncertainty)", A);
   b.pos("firmware.max_speed_rpm", &f.max_speed_rpm, "Table 1.1", "largest speed setpoint accepted");
   b.pos("firmware.overspeed_trip_rpm", &f.overspeed_trip_rpm, "assumed", "over-speed trip", A);
   b.pos("firmware.overcurrent_trip_A", &f.overcurrent_trip_A, "assumed", "over-current trip (peak phase)", A);

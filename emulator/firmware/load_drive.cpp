@@ -80,10 +80,12 @@ double LoadDriveFirmware::control(double iq_measured_A) {
   f_iq_.update(iq_measured_A);
   if (window_left_ > 0) {
     w_iq_.add(iq_measured_A);
+    b_iq_.add(iq_measured_A);
     if (--window_left_ == 0) {
       window_result_ = {};
       window_result_.samples = static_cast<std::uint32_t>(w_iq_.count());
       window_result_.torque_Nm = kt_ * w_iq_.mean();
+      window_result_.batch_torque_Nm = b_iq_.means(kt_);
     }
   }
   return torque_cmd_Nm_ / kt_;
@@ -92,6 +94,7 @@ double LoadDriveFirmware::control(double iq_measured_A) {
 void LoadDriveFirmware::begin_window(std::int64_t steps) {
   window_left_ = steps;
   w_iq_.reset();
+  b_iq_.reset(steps, cfg_.firmware.window_batches);
 }
 
 drivers::LoadTelemetry LoadDriveFirmware::telemetry() const {

@@ -8,6 +8,7 @@
 
 #include "drivers/devices.hpp"
 #include "emulator/firmware/pi.hpp"
+#include "emulator/firmware/window_batches.hpp"
 #include "emulator/firmware/window_stats.hpp"
 #include "emulator/twin_config.hpp"
 
@@ -48,6 +49,7 @@ class LoadDriveFirmware {
   LowPass f_iq_;
   std::int64_t window_left_ = 0;
   WindowStats w_iq_;
+  WindowBatches b_iq_;
   drivers::LoadWindow window_result_;
 };
 

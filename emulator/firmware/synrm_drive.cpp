@@ -362,13 +362,17 @@ void SynrmDriveFirmware::begin_window(std::int64_t steps) {
   for (WindowStats* w : {&w_im_, &w_id_, &w_iq_, &w_ud_, &w_uq_, &w_udc_, &w_temp_, &w_pos_err_,
                          &w_speed_err_, &w_ld_, &w_lq_, &w_rs_, &w_id_enc_, &w_iq_enc_})
     w->reset();
+  b_im_.reset(steps, cfg_.firmware.window_batches);
+  batch_count_start_.clear();
 }
 
 void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, double iq,
                                     bool limited, double pos_err_rad, double speed_err_rpm) {
   if (window_left_ <= 0) return;
   if (window_count_start_ < 0) window_count_start_ = s.encoder_count;
+  if (b_im_.at_batch_start()) batch_count_start_.push_back(s.encoder_count);
   w_im_.add(im);
+  b_im_.add(im);
   w_id_.add(id);
   w_iq_.add(iq);
   w_ud_.add(ud_ref_);
@@ -410,6 +414,19 @@ void SynrmDriveFirmware::accumulate(const DriveSample& s, double im, double id, 
   r.speed_meas_rpm = static_cast<double>(s.encoder_count - window_count_start_) / counts_per_rev_ /
                      span_s * 60.0;
   r.im_A = w_im_.mean();
+  r.batch_im_A = b_im_.means();
+  if (!r.batch_im_A.empty()) {
+    // A batch's speed from the encoder counts between its first sample and the next batch's
+    // (the last: the window's last sample), as the window's own.
+    const std::int64_t len = b_im_.batch_length();
+    for (std::size_t k = 0; k < batch_count_start_.size(); ++k) {
+      const bool last = k + 1 == batch_count_start_.size();
+      const std::int64_t end = last ? s.encoder_count : batch_count_start_[k + 1];
+      const double periods = static_cast<double>(last ? (len > 1 ? len - 1 : 1) : len);
+      r.batch_speed_meas_rpm.push_back(static_cast<double>(end - batch_count_start_[k]) /
+                                       counts_per_rev_ / (periods * ts_) * 60.0);
+    }
+  }
   r.id_A = w_id_.mean();
   r.iq_A = w_iq_.mean();
   r.ud_V = w_ud_.mean();

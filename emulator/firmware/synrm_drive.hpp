@@ -8,11 +8,13 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 #include <system_error>
 
 #include "drivers/devices.hpp"
 #include "emulator/firmware/estimators/estimator.hpp"
 #include "emulator/firmware/pi.hpp"
+#include "emulator/firmware/window_batches.hpp"
 #include "emulator/firmware/window_stats.hpp"
 #include "emulator/flux_map.hpp"
 #include "emulator/inverter_model.hpp"
@@ -130,6 +132,8 @@ class SynrmDriveFirmware {
   drivers::Fault window_fault_ = drivers::Fault::none;
   WindowStats w_im_, w_id_, w_iq_, w_ud_, w_uq_, w_udc_, w_temp_;
   WindowStats w_pos_err_, w_speed_err_, w_ld_, w_lq_, w_rs_, w_id_enc_, w_iq_enc_;
+  WindowBatches b_im_;
+  std::vector<std::int64_t> batch_count_start_;  // encoder count at each batch's first sample
   drivers::SynrmWindow window_result_;
 };
 
