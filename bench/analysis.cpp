@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <tuple>
 
 #include "bench/analysis_fit.hpp"
+#include "bench/analysis_uncertainty.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -23,21 +25,57 @@ CurveKey key_of(const PointRecord& r) {
   return {Configuration{r.estimator, r.pwm}, setpoint_key(r.speed_rpm), setpoint_key(r.load_Nm)};
 }
 
-double ratio(double num, double den) { return den > 0 ? num / den : 0.0; }
 
-CurveOptimum optimum(const std::vector<double>& x, const std::vector<double>& im, const std::vector<double>& pdcm,
-                     const std::vector<double>& pm, bool by_current) {
-  const auto m = refine_minimum(x, by_current ? im : pdcm);
-  CurveOptimum o;
-  o.angle_deg = m.x;
-  o.refined = m.refined;
-  o.at_edge = m.at_edge;
-  // Read the other quantities at the refined angle through the same three samples.
-  o.im_A = by_current ? m.y : (m.refined ? interpolate_at(x, im, m.index, m.x) : im[m.index]);
-  o.pdcm_W = by_current ? (m.refined ? interpolate_at(x, pdcm, m.index, m.x) : pdcm[m.index]) : m.y;
-  o.pm_W = m.refined ? interpolate_at(x, pm, m.index, m.x) : pm[m.index];
-  o.efficiency = ratio(o.pm_W, o.pdcm_W);
-  return o;
+// One quantity's uncertainties per distinct angle while repeats are averaged: the repeat parts
+// of a mean of n add in quadrature over n, the systematic parts (common to the repeats) average.
+struct UncertaintySum {
+  bool repeat_known = true, known = true;
+  std::vector<double> repeat2, systematic;
+  void start() {
+    repeat2.push_back(0);
+    systematic.push_back(0);
+  }
+  void add(const std::optional<double>& u, const std::optional<double>& repeat) {
+    repeat_known = repeat_known && repeat && std::isfinite(*repeat);
+    known = known && repeat_known && u && std::isfinite(*u);
+    if (repeat_known) repeat2.back() += *repeat * *repeat;
+    if (known) systematic.back() += std::sqrt(std::max(0.0, *u * *u - *repeat * *repeat));
+  }
+  SampleUncertainty mean(const std::vector<std::size_t>& n) const {
+    SampleUncertainty out;
+    if (!repeat_known) return out;
+    for (std::size_t k = 0; k < n.size(); ++k) out.repeat.push_back(std::sqrt(repeat2[k]) / static_cast<double>(n[k]));
+    if (!known) return out;
+    for (std::size_t k = 0; k < n.size(); ++k) out.systematic.push_back(systematic[k] / static_cast<double>(n[k]));
+    return out;
+  }
+};
+
+// The record carries pm_W's combined u but not its repeat part; efficiency = pm_W / pdcm_W with
+// independent meters gives u_eff^2 = (u_pm / pdcm)^2 + (eff u_pdcm / pdcm)^2, solved for u_pm.
+std::optional<double> pm_u_repeat_W(const PointRecord& r) {
+  if (!r.efficiency_u_repeat || !r.pdcm_u_repeat_W || !(r.pdcm_W > 0)) return std::nullopt;
+  const double eff = r.pm_W / r.pdcm_W;
+  const double a = r.pdcm_W * *r.efficiency_u_repeat, b = eff * *r.pdcm_u_repeat_W;
+  return std::sqrt(std::max(0.0, a * a - b * b));
+}
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
+  // splitmix64's finaliser over h + v: distinct curves get unrelated streams.
+  std::uint64_t x = h + v + 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+// A seed per curve from the analysis' seed and the curve's key, so a curve's result does not
+// depend on which other curves are analysed with it.
+std::uint64_t curve_seed(std::uint64_t seed, const CurveKey& key) {
+  const auto& [config, speed, load] = key;
+  std::uint64_t h = mix(seed, static_cast<std::uint64_t>(config.estimator));
+  h = mix(h, static_cast<std::uint64_t>(config.pwm));
+  h = mix(h, static_cast<std::uint64_t>(speed));
+  return mix(h, static_cast<std::uint64_t>(load));
 }
 
 struct Quantity {
@@ -113,6 +151,7 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
     // Repeats at one angle are averaged: a re-measured point counts once.
     std::vector<double> im, pdcm, pm;
     std::vector<std::size_t> n;
+    UncertaintySum im_u, pdcm_u, pm_u, eff_u;
     for (auto i : idx) {
       const auto& r = records[i];
       if (!c.angles_deg.empty() && std::fabs(r.angle_deg - c.angles_deg.back()) < 1e-6) {
@@ -120,13 +159,18 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
         pdcm.back() += r.pdcm_W;
         pm.back() += r.pm_W;
         ++n.back();
-        continue;
+      } else {
+        c.angles_deg.push_back(r.angle_deg);
+        im.push_back(r.im_A);
+        pdcm.push_back(r.pdcm_W);
+        pm.push_back(r.pm_W);
+        n.push_back(1);
+        for (auto* u : {&im_u, &pdcm_u, &pm_u, &eff_u}) u->start();
       }
-      c.angles_deg.push_back(r.angle_deg);
-      im.push_back(r.im_A);
-      pdcm.push_back(r.pdcm_W);
-      pm.push_back(r.pm_W);
-      n.push_back(1);
+      im_u.add(r.im_u_A, r.im_u_repeat_A);
+      pdcm_u.add(r.pdcm_u_W, r.pdcm_u_repeat_W);
+      pm_u.add(r.pm_u_W, pm_u_repeat_W(r));
+      eff_u.add(r.efficiency_u, r.efficiency_u_repeat);
     }
     for (std::size_t k = 0; k < n.size(); ++k) {
       const double d = static_cast<double>(n[k]);
@@ -134,8 +178,13 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
       pdcm[k] /= d;
       pm[k] /= d;
     }
-    c.mtpa = optimum(c.angles_deg, im, pdcm, pm, true);
-    c.me = optimum(c.angles_deg, im, pdcm, pm, false);
+    c.mtpa = curve_optimum(c.angles_deg, im, pdcm, pm, true);
+    c.me = curve_optimum(c.angles_deg, im, pdcm, pm, false);
+    c.me_minus_mtpa_deg = c.me.angle_deg - c.mtpa.angle_deg;
+    // 2a. Their uncertainties from the points' (JCGM 101 Monte Carlo over the curve).
+    const CurveSamples samples{c.angles_deg,  im,          pdcm,        pm,
+                               im_u.mean(n), pdcm_u.mean(n), pm_u.mean(n), eff_u.mean(n)};
+    propagate_curve_uncertainty(c, samples, {options.uncertainty_draws, curve_seed(options.uncertainty_seed, key)});
     curve_index[key] = a.curves.size();
     a.curves.push_back(std::move(c));
   }
@@ -148,7 +197,12 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
     const auto& c = a.curves[ci];
     const auto& r = a.curves[ref->second];
     auto delta = [](const CurveOptimum& x, const CurveOptimum& y) {
-      return TrajectoryDelta{x.angle_deg - y.angle_deg, x.im_A - y.im_A, x.pdcm_W - y.pdcm_W};
+      TrajectoryDelta d;
+      d.delta_angle_deg = x.angle_deg - y.angle_deg;
+      d.delta_im_A = x.im_A - y.im_A;
+      d.delta_pdcm_W = x.pdcm_W - y.pdcm_W;
+      add_delta_uncertainty(d, x, y);
+      return d;
     };
     a.deltas.push_back({c.configuration, c.speed_rpm, c.load_Nm, delta(c.mtpa, r.mtpa), delta(c.me, r.me)});
   }
@@ -203,9 +257,22 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
   }
 
   // 6. Efficiency map at the ME angle.
-  for (const auto& c : a.curves)
-    a.efficiency.push_back({c.configuration, c.speed_rpm, c.load_Nm, c.me.angle_deg, c.me.pm_W, c.me.pdcm_W,
-                            c.me.efficiency, c.me.refined});
+  for (const auto& c : a.curves) {
+    EfficiencyCell cell;
+    cell.configuration = c.configuration;
+    cell.speed_rpm = c.speed_rpm;
+    cell.load_Nm = c.load_Nm;
+    cell.angle_deg = c.me.angle_deg;
+    cell.pm_W = c.me.pm_W;
+    cell.pdcm_W = c.me.pdcm_W;
+    cell.efficiency = c.me.efficiency;
+    cell.refined = c.me.refined;
+    cell.pm_u_W = c.me.pm_u_W;
+    cell.pdcm_u_W = c.me.pdcm_u_W;
+    cell.efficiency_u = c.me.efficiency_u;
+    cell.efficiency_u_repeat = c.me.efficiency_u_repeat;
+    a.efficiency.push_back(cell);
+  }
   a.efficiency_contours = efficiency_contours(a.efficiency, options.contours);
   return a;
 }

@@ -8,6 +8,7 @@
 #include "drivers/json_fwd.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ struct AnalysisOptions {
   double rs_err_bin_pct = 20.0;
   // Levels and resolution of the efficiency map's iso-lines (default: "nice" steps).
   ContourOptions contours;
+  // Monte Carlo propagation of the points' uncertainties to the optima (JCGM 101): draws per
+  // curve (400 puts an SD within about 3.5 % of its limit) and the seed, so results repeat.
+  std::size_t uncertainty_draws = 400;
+  std::uint64_t uncertainty_seed = 20081;
 };
 
 // An optimum of one curve, with both quantities (and the shaft power) read at its angle from the
@@ -47,6 +52,15 @@ struct CurveOptimum {
   double efficiency = 0;  // pm_W / pdcm_W
   bool refined = false;   // false: the smallest sample itself (at an edge, or < 3 angles)
   bool at_edge = false;   // the smallest sample is the first or last angle measured
+  // Standard uncertainties (k = 1) of the values read at the optimum (bench/analysis_uncertainty.hpp):
+  // `_u` for the absolute value (the Monte Carlo repeat part combined with the points'
+  // systematic part), `_u_repeat` the point-to-point part alone, which a difference between two
+  // curves of one bench carries. Empty where a point of the curve has no uncertainty.
+  std::optional<double> angle_u_deg;
+  std::optional<double> im_u_A, im_u_repeat_A;
+  std::optional<double> pdcm_u_W, pdcm_u_repeat_W;
+  std::optional<double> pm_u_W;
+  std::optional<double> efficiency_u, efficiency_u_repeat;
 };
 
 // One (configuration, speed, load) curve over the current angle.
@@ -57,11 +71,20 @@ struct CurveResult {
   std::vector<double> angles_deg;  // distinct angles measured (repeats averaged), ascending
   CurveOptimum mtpa;             // minimum of im_A
   CurveOptimum me;               // minimum of pdcm_W
+  // ME angle minus MTPA angle, its standard uncertainty from the same Monte Carlo draws, and
+  // whether 0 lies outside the central 95 % interval of the drawn differences (empty: unknown).
+  double me_minus_mtpa_deg = 0;
+  std::optional<double> me_minus_mtpa_u_deg;
+  std::optional<bool> me_minus_mtpa_significant;
 };
 
 // Configuration minus reference at the same (speed, load), on each optimal trajectory.
+// The uncertainties combine the two optima's point-to-point parts in quadrature (one bench: the
+// systematic parts cancel); significant: |delta| > 1.96 u (empty when u is unknown).
 struct TrajectoryDelta {
   double delta_angle_deg = 0, delta_im_A = 0, delta_pdcm_W = 0;
+  std::optional<double> delta_angle_u_deg, delta_im_u_A, delta_pdcm_u_W;
+  std::optional<bool> delta_angle_significant, delta_im_significant, delta_pdcm_significant;
 };
 struct DeltaResult {
   Configuration configuration;
@@ -100,6 +123,8 @@ struct EfficiencyCell {
   double speed_rpm = 0, load_Nm = 0;
   double angle_deg = 0, pm_W = 0, pdcm_W = 0, efficiency = 0;
   bool refined = false;
+  // Those of the curve's ME optimum (CurveOptimum).
+  std::optional<double> pm_u_W, pdcm_u_W, efficiency_u, efficiency_u_repeat;
 };
 
 struct ExcludedPoint {

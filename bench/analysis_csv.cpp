@@ -4,6 +4,7 @@
 // exist (no delta for the reference, no position error for the encoder).
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -21,6 +22,8 @@ std::string cell(double v) {
   s << v;
   return s.str();
 }
+std::string cell(const std::optional<double>& v) { return v ? cell(*v) : std::string(); }
+std::string cell(const std::optional<bool>& v) { return v ? (*v ? "1" : "0") : ""; }
 
 }  // namespace
 
@@ -34,7 +37,12 @@ std::string analysis_curves_csv(const Analysis& a) {
   o << "estimator,pwm,speed_rpm,load_Nm,points,"
        "mtpa_angle_deg,mtpa_im_A,mtpa_pdcm_W,mtpa_refined,me_angle_deg,me_im_A,me_pdcm_W,me_pm_W,me_efficiency,me_refined,"
        "mtpa_delta_angle_deg,mtpa_delta_im_A,mtpa_delta_pdcm_W,me_delta_angle_deg,me_delta_im_A,me_delta_pdcm_W,"
-       "pos_err_min_deg,pos_err_mean_deg,pos_err_max_deg\n";
+       "pos_err_min_deg,pos_err_mean_deg,pos_err_max_deg,"
+       "mtpa_angle_u_deg,mtpa_im_u_A,mtpa_pdcm_u_W,me_angle_u_deg,me_im_u_A,me_pdcm_u_W,me_pm_u_W,me_efficiency_u,"
+       "me_efficiency_u_repeat,me_minus_mtpa_deg,me_minus_mtpa_u_deg,me_minus_mtpa_significant,"
+       "mtpa_delta_angle_u_deg,mtpa_delta_im_u_A,mtpa_delta_pdcm_u_W,mtpa_delta_angle_significant,"
+       "mtpa_delta_im_significant,mtpa_delta_pdcm_significant,me_delta_angle_u_deg,me_delta_im_u_A,me_delta_pdcm_u_W,"
+       "me_delta_angle_significant,me_delta_im_significant,me_delta_pdcm_significant\n";
   for (const auto& c : a.curves) {
     const Key k{c.configuration, c.speed_rpm, c.load_Nm};
     o << drivers::name(c.configuration.estimator) << ',' << drivers::name(c.configuration.pwm) << ',' << cell(c.speed_rpm)
@@ -53,6 +61,18 @@ std::string analysis_curves_csv(const Analysis& a) {
       o << ',' << cell(it->second->min_deg) << ',' << cell(it->second->mean_deg) << ',' << cell(it->second->max_deg);
     else
       o << ",,,";
+    o << ',' << cell(c.mtpa.angle_u_deg) << ',' << cell(c.mtpa.im_u_A) << ',' << cell(c.mtpa.pdcm_u_W) << ','
+      << cell(c.me.angle_u_deg) << ',' << cell(c.me.im_u_A) << ',' << cell(c.me.pdcm_u_W) << ',' << cell(c.me.pm_u_W)
+      << ',' << cell(c.me.efficiency_u) << ',' << cell(c.me.efficiency_u_repeat) << ',' << cell(c.me_minus_mtpa_deg)
+      << ',' << cell(c.me_minus_mtpa_u_deg) << ',' << cell(c.me_minus_mtpa_significant);
+    if (auto it = deltas.find(k); it != deltas.end()) {
+      for (const auto* t : {&it->second->mtpa, &it->second->me})
+        o << ',' << cell(t->delta_angle_u_deg) << ',' << cell(t->delta_im_u_A) << ',' << cell(t->delta_pdcm_u_W) << ','
+          << cell(t->delta_angle_significant) << ',' << cell(t->delta_im_significant) << ','
+          << cell(t->delta_pdcm_significant);
+    } else {
+      o << ",,,,,,,,,,,,";
+    }
     o << '\n';
   }
   return o.str();

@@ -2,7 +2,6 @@
 #include "bench/analysis_fit.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -66,12 +65,16 @@ RefinedMinimum refine_minimum(std::span<const double> x, std::span<const double>
   m.at_edge = n > 1 && (m.index == 0 || m.index == n - 1);
   if (n < 3 || m.at_edge) return m;
   const std::size_t i = m.index;
-  const std::array<double, 3> xs{x[i - 1], x[i], x[i + 1]}, ys{y[i - 1], y[i], y[i + 1]};
-  const auto q = fit_quadratic(xs, ys);
-  if (!q || q->c2 <= 0) return m;
+  // The parabola through the three samples in Newton's form (closed form: the Monte Carlo of
+  // bench/analysis_uncertainty.hpp refines every curve hundreds of times):
+  // p(x) = y0 + f01 (x - x0) + f012 (x - x0)(x - x1).
+  const double x0 = x[i - 1], x1 = x[i], x2 = x[i + 1];
+  const double f01 = (y[i] - y[i - 1]) / (x1 - x0), f12 = (y[i + 1] - y[i]) / (x2 - x1);
+  const double f012 = (f12 - f01) / (x2 - x0);
+  if (!(f012 > 0)) return m;
   // The smallest sample is below both neighbours, so the vertex lies between them.
-  m.x = std::clamp(q->vertex(), xs[0], xs[2]);
-  m.y = (*q)(m.x);
+  m.x = std::clamp(0.5 * (x0 + x1) - f01 / (2 * f012), x0, x2);
+  m.y = y[i - 1] + (m.x - x0) * (f01 + f012 * (m.x - x1));
   m.refined = true;
   return m;
 }

@@ -18,6 +18,8 @@ using ojson = synbench::Json;
 // A JSON document must not carry NaN or infinities (nlohmann writes them as null anyway; this
 // makes it explicit and keeps the C++ side honest).
 ojson number(double v) { return std::isfinite(v) ? ojson(v) : ojson(nullptr); }
+ojson number(const std::optional<double>& v) { return v ? number(*v) : ojson(nullptr); }
+ojson flag(const std::optional<bool>& v) { return v ? ojson(*v) : ojson(nullptr); }
 
 void put_configuration(ojson& j, const Configuration& c) {
   j["estimator"] = std::string(drivers::name(c.estimator));
@@ -39,6 +41,13 @@ ojson optimum(const CurveOptimum& o) {
   j["efficiency"] = o.pdcm_W > 0 ? number(o.efficiency) : ojson(nullptr);
   j["refined"] = o.refined;
   j["at_edge"] = o.at_edge;
+  j["im_u_A"] = number(o.im_u_A);
+  j["im_u_repeat_A"] = number(o.im_u_repeat_A);
+  j["pdcm_u_W"] = number(o.pdcm_u_W);
+  j["pdcm_u_repeat_W"] = number(o.pdcm_u_repeat_W);
+  j["pm_u_W"] = number(o.pm_u_W);
+  j["efficiency_u"] = number(o.efficiency_u);
+  j["efficiency_u_repeat"] = number(o.efficiency_u_repeat);
   return j;
 }
 
@@ -47,7 +56,24 @@ ojson delta(const TrajectoryDelta& d) {
   j["delta_angle_deg"] = number(d.delta_angle_deg);
   j["delta_im_A"] = number(d.delta_im_A);
   j["delta_pdcm_W"] = number(d.delta_pdcm_W);
+  j["delta_angle_u_deg"] = number(d.delta_angle_u_deg);
+  j["delta_im_u_A"] = number(d.delta_im_u_A);
+  j["delta_pdcm_u_W"] = number(d.delta_pdcm_u_W);
+  j["delta_angle_significant"] = flag(d.delta_angle_significant);
+  j["delta_im_significant"] = flag(d.delta_im_significant);
+  j["delta_pdcm_significant"] = flag(d.delta_pdcm_significant);
   return j;
+}
+
+// A measured grid (rows = load) served rows = speed, null where not measured.
+ojson grid_matrix(const MeasuredGrid& g) {
+  ojson matrix = ojson::array();
+  for (std::size_t i = 0; i < g.speed_rpm.size(); ++i) {
+    ojson row = ojson::array();
+    for (std::size_t k = 0; k < g.load_Nm.size(); ++k) row.push_back(g.values[k][i] ? number(*g.values[k][i]) : ojson(nullptr));
+    matrix.push_back(row);
+  }
+  return matrix;
 }
 
 ojson section(const char* description, const char* figures) {
@@ -55,6 +81,68 @@ ojson section(const char* description, const char* figures) {
   j["description"] = description;
   j["thesis_figures"] = figures ? ojson(figures) : ojson(nullptr);
   return j;
+}
+
+// How many of the known differences are significant at 95 %: what a closing note quotes.
+ojson counted(std::size_t known, std::size_t significant) {
+  return {{"known", known}, {"significant", significant}};
+}
+
+ojson uncertainty_summary(const Analysis& a) {
+  ojson u = section(
+      "Standard uncertainties (k = 1, GUM) propagated from the points' uncertainties (record fields *_u*). "
+      "Per curve, Monte Carlo (JCGM 101): every point's im_A, pdcm_W and pm_W drawn from a normal "
+      "distribution around its value with its point-to-point (repeat) standard uncertainty, the refinement "
+      "redone per draw; an optimum's angle u is the SD of the drawn angles (the systematic parts shift a whole "
+      "curve and do not move its minimum); a value's u at an optimum combines the drawn SD with the points' "
+      "systematic part sqrt(u^2 - u_repeat^2). im and pdcm noise are drawn independently. ME minus MTPA: "
+      "SD of the drawn differences, significant when 0 lies outside their central 95 % interval. Deltas "
+      "against the reference: the two optima's repeat parts in quadrature (one bench: the systematic parts "
+      "cancel; not valid between two benches), significant when |delta| > 1.96 u. Null wherever a point "
+      "lacks an uncertainty, and for an angle whose optimum is at an edge or not refined.",
+      nullptr);
+  ojson method = ojson::object();
+  method["propagation"] = "monte_carlo";
+  method["draws"] = a.options.uncertainty_draws;
+  method["seed"] = a.options.uncertainty_seed;
+  method["coverage"] = 0.95;
+  method["delta_significance"] = "abs(delta) > 1.96 u";
+  method["me_minus_mtpa_significance"] = "0 outside the central 95 % interval of the draws";
+  u["method"] = method;
+  std::size_t known = 0, significant = 0;
+  for (const auto& c : a.curves)
+    if (c.me_minus_mtpa_significant) {
+      ++known;
+      if (*c.me_minus_mtpa_significant) ++significant;
+    }
+  u["me_minus_mtpa"] = {{"curves", a.curves.size()}, {"known", known}, {"significant", significant}};
+  ojson deltas = ojson::object();
+  deltas["entries"] = a.deltas.size();
+  const auto trajectory = [&](TrajectoryDelta DeltaResult::*t) {
+    std::size_t k[3] = {0, 0, 0}, s[3] = {0, 0, 0};
+    for (const auto& d : a.deltas) {
+      const std::optional<bool> f[3] = {(d.*t).delta_angle_significant, (d.*t).delta_im_significant,
+                                        (d.*t).delta_pdcm_significant};
+      for (std::size_t q = 0; q < 3; ++q)
+        if (f[q]) {
+          ++k[q];
+          if (*f[q]) ++s[q];
+        }
+    }
+    ojson x = ojson::object();
+    x["delta_angle_deg"] = counted(k[0], s[0]);
+    x["delta_im_A"] = counted(k[1], s[1]);
+    x["delta_pdcm_W"] = counted(k[2], s[2]);
+    return x;
+  };
+  deltas["mtpa"] = trajectory(&DeltaResult::mtpa);
+  deltas["me"] = trajectory(&DeltaResult::me);
+  u["deltas"] = deltas;
+  std::size_t cells_known = 0;
+  for (const auto& c : a.efficiency)
+    if (c.efficiency_u) ++cells_known;
+  u["efficiency_map"] = {{"cells", a.efficiency.size()}, {"known", cells_known}};
+  return u;
 }
 
 }  // namespace
@@ -110,6 +198,11 @@ ojson to_json(const Analysis& a) {
     x["angles_deg"] = c.angles_deg;
     x["mtpa"] = optimum(c.mtpa);
     x["me"] = optimum(c.me);
+    x["mtpa_angle_u_deg"] = number(c.mtpa.angle_u_deg);
+    x["me_angle_u_deg"] = number(c.me.angle_u_deg);
+    x["me_minus_mtpa_deg"] = number(c.me_minus_mtpa_deg);
+    x["me_minus_mtpa_u_deg"] = number(c.me_minus_mtpa_u_deg);
+    x["me_minus_mtpa_significant"] = flag(c.me_minus_mtpa_significant);
     ce.push_back(x);
   }
   curves["entries"] = ce;
@@ -201,17 +294,15 @@ ojson to_json(const Analysis& a) {
   for (const auto& [config, cells] : by_config) {
     // The one measured grid (bench/efficiency_grid.hpp, rows = load) served here rows = speed.
     const MeasuredGrid g = measured_efficiency_grid(a.efficiency, config);
-    ojson matrix = ojson::array();
-    for (std::size_t i = 0; i < g.speed_rpm.size(); ++i) {
-      ojson row = ojson::array();
-      for (std::size_t k = 0; k < g.load_Nm.size(); ++k) row.push_back(g.values[k][i] ? number(*g.values[k][i]) : ojson(nullptr));
-      matrix.push_back(row);
-    }
+    const ojson matrix = grid_matrix(g);
     ojson m = ojson::object();
     put_configuration(m, config);
     m["speeds_rpm"] = g.speed_rpm;
     m["loads_Nm"] = g.load_Nm;
     m["efficiency"] = matrix;
+    m["efficiency_u"] = grid_matrix(measured_efficiency_grid(a.efficiency, config, &EfficiencyCell::efficiency_u));
+    m["efficiency_u_repeat"] =
+        grid_matrix(measured_efficiency_grid(a.efficiency, config, &EfficiencyCell::efficiency_u_repeat));
     ojson list = ojson::array();
     for (const auto* c : cells) {
       ojson x = ojson::object();
@@ -222,6 +313,10 @@ ojson to_json(const Analysis& a) {
       x["pdcm_W"] = number(c->pdcm_W);
       x["efficiency"] = c->pdcm_W > 0 ? number(c->efficiency) : ojson(nullptr);
       x["refined"] = c->refined;
+      x["pm_u_W"] = number(c->pm_u_W);
+      x["pdcm_u_W"] = number(c->pdcm_u_W);
+      x["efficiency_u"] = number(c->efficiency_u);
+      x["efficiency_u_repeat"] = number(c->efficiency_u_repeat);
       list.push_back(x);
     }
     m["cells"] = list;
@@ -262,6 +357,7 @@ ojson to_json(const Analysis& a) {
   }
   ec["entries"] = ce2;
   j["efficiency_contours"] = ec;
+  j["uncertainty"] = uncertainty_summary(a);
   return j;
 }
 

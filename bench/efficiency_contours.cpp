@@ -170,6 +170,11 @@ EfficiencyContours contours_of(const MeasuredGrid& g, const ContourOptions& opti
 }
 
 MeasuredGrid measured_efficiency_grid(const std::vector<EfficiencyCell>& cells, const Configuration& configuration) {
+  return measured_efficiency_grid(cells, configuration, nullptr);
+}
+
+MeasuredGrid measured_efficiency_grid(const std::vector<EfficiencyCell>& cells, const Configuration& configuration,
+                                      std::optional<double> EfficiencyCell::*field) {
   const auto add = [](std::vector<double>& v, double x) {
     for (double y : v)
       if (std::fabs(y - x) < 1e-6) return;
@@ -191,7 +196,8 @@ MeasuredGrid measured_efficiency_grid(const std::vector<EfficiencyCell>& cells, 
   g.values.assign(g.load_Nm.size(), std::vector<std::optional<double>>(g.speed_rpm.size()));
   for (const auto& c : cells)
     if (c.configuration == configuration && c.pdcm_W > 0 && std::isfinite(c.efficiency))
-      g.values[index(g.load_Nm, c.load_Nm)][index(g.speed_rpm, c.speed_rpm)] = c.efficiency;
+      g.values[index(g.load_Nm, c.load_Nm)][index(g.speed_rpm, c.speed_rpm)] =
+          field ? c.*field : std::optional<double>(c.efficiency);
   return g;
 }
 

@@ -156,12 +156,87 @@ synbench::Json contours_schema() {
 }
 }  // namespace
 
+namespace {
+// An open object (other members allowed) requiring `properties`.
+synbench::Json open_object(synbench::Json properties) {
+  synbench::Json required = synbench::Json::array();
+  for (const auto& [name, _] : properties.items()) required.push_back(name);
+  return {{"type", "object"}, {"required", std::move(required)}, {"properties", std::move(properties)}};
+}
+
+synbench::Json entries_of(synbench::Json entry) {
+  return open_object({{"entries", {{"type", "array"}, {"items", std::move(entry)}}}});
+}
+
+// The uncertainties the analysis adds (docs/analysis.md, "Uncertainty"): null where unknown.
+synbench::Json curves_schema() {
+  const synbench::Json optimum = open_object({{"im_u_A", nullable(kNum)},
+                                              {"im_u_repeat_A", nullable(kNum)},
+                                              {"pdcm_u_W", nullable(kNum)},
+                                              {"pdcm_u_repeat_W", nullable(kNum)},
+                                              {"pm_u_W", nullable(kNum)},
+                                              {"efficiency_u", nullable(kNum)},
+                                              {"efficiency_u_repeat", nullable(kNum)}});
+  return entries_of(open_object({{"mtpa", optimum},
+                                 {"me", optimum},
+                                 {"mtpa_angle_u_deg", nullable(kNum)},
+                                 {"me_angle_u_deg", nullable(kNum)},
+                                 {"me_minus_mtpa_deg", nullable(kNum)},
+                                 {"me_minus_mtpa_u_deg", nullable(kNum)},
+                                 {"me_minus_mtpa_significant", nullable(kBool)}}));
+}
+
+synbench::Json deltas_schema() {
+  const synbench::Json trajectory = open_object({{"delta_angle_u_deg", nullable(kNum)},
+                                                 {"delta_im_u_A", nullable(kNum)},
+                                                 {"delta_pdcm_u_W", nullable(kNum)},
+                                                 {"delta_angle_significant", nullable(kBool)},
+                                                 {"delta_im_significant", nullable(kBool)},
+                                                 {"delta_pdcm_significant", nullable(kBool)}});
+  return entries_of(open_object({{"mtpa", trajectory}, {"me", trajectory}}));
+}
+
+synbench::Json efficiency_map_schema() {
+  const synbench::Json matrix = {{"type", "array"}, {"items", {{"type", "array"}, {"items", nullable(kNum)}}}};
+  const synbench::Json cell = open_object({{"pm_u_W", nullable(kNum)},
+                                           {"pdcm_u_W", nullable(kNum)},
+                                           {"efficiency_u", nullable(kNum)},
+                                           {"efficiency_u_repeat", nullable(kNum)}});
+  return entries_of(open_object({{"efficiency", matrix},
+                                 {"efficiency_u", matrix},
+                                 {"efficiency_u_repeat", matrix},
+                                 {"cells", {{"type", "array"}, {"items", cell}}}}));
+}
+
+synbench::Json uncertainty_schema() {
+  const synbench::Json counted = closed_object({{"known", kInt}, {"significant", kInt}});
+  const synbench::Json trajectory =
+      closed_object({{"delta_angle_deg", counted}, {"delta_im_A", counted}, {"delta_pdcm_W", counted}});
+  return open_object(
+      {{"description", kStr},
+       {"method",
+        closed_object({{"propagation", kStr},
+                       {"draws", kInt},
+                       {"seed", kInt},
+                       {"coverage", kNum},
+                       {"delta_significance", kStr},
+                       {"me_minus_mtpa_significance", kStr}})},
+       {"me_minus_mtpa", closed_object({{"curves", kInt}, {"known", kInt}, {"significant", kInt}})},
+       {"deltas", closed_object({{"entries", kInt}, {"mtpa", trajectory}, {"me", trajectory}})},
+       {"efficiency_map", closed_object({{"cells", kInt}, {"known", kInt}})}});
+}
+}  // namespace
+
 synbench::Json analysis_schema() {
   return {{"type", "object"},
           {"required", synbench::Json::array({"schema"})},
           {"properties",
            {{"schema", {{"type", "string"}, {"enum", synbench::Json::array({"synbench.analysis/1"})}}},
-            {"efficiency_contours", contours_schema()}}},
+            {"curves", curves_schema()},
+            {"deltas", deltas_schema()},
+            {"efficiency_map", efficiency_map_schema()},
+            {"efficiency_contours", contours_schema()},
+            {"uncertainty", uncertainty_schema()}}},
           {"description", "docs/analysis.md"}};
 }
 

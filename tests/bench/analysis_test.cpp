@@ -366,7 +366,7 @@ TEST(Analysis, JsonIsSelfDescribingAndStable) {
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
   EXPECT_EQ(keys, (std::vector<std::string>{"schema", "options", "points", "curves", "deltas", "histograms",
-                                            "position_error", "efficiency_map", "efficiency_contours"}));
+                                            "position_error", "efficiency_map", "efficiency_contours", "uncertainty"}));
   EXPECT_EQ(j["schema"], "synbench.analysis/1");
   EXPECT_EQ(j["options"]["reference"]["estimator"], "encoder");
   EXPECT_EQ(j["options"]["bin_width"]["rs_err_pct"], 20.0);

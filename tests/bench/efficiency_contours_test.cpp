@@ -160,7 +160,7 @@ TEST(EfficiencyContours, AnalysisJsonCarriesTheField) {
   const auto g = planar_grid();
   for (std::size_t r = 0; r < g.load_Nm.size(); ++r)
     for (std::size_t k = 0; k < g.speed_rpm.size(); ++k)
-      a.efficiency.push_back({cfg, g.speed_rpm[k], g.load_Nm[r], 50, 100 * *g.values[r][k], 100, *g.values[r][k], true});
+      a.efficiency.push_back({cfg, g.speed_rpm[k], g.load_Nm[r], 50, 100 * *g.values[r][k], 100, *g.values[r][k], true, {}, {}, {}, {}});
   a.efficiency_contours = efficiency_contours(a.efficiency, {.levels = {}, .step = 0.05, .subdivisions = 2});
   const auto j = to_json(a);
   const auto& e = j.at("efficiency_contours").at("entries");
