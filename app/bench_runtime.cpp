@@ -416,6 +416,7 @@ void BenchRuntime::start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<
         sweep_store_ = std::make_unique<db::Store>(std::move(*opened));
         SweepRunOptions options;
         options.calibration.load_b1_Nms_per_rad = description_.load_b1_Nms_per_rad;
+        options.calibration.uncertainty = description_.uncertainty;
         sweep_ = std::make_unique<SweepRun>(commanded_->devices(), *supervisor_, *sweep_store_, id, std::move(shared->first),
                                             std::move(shared->second), options);
         if (auto e = sweep_->begin()) {

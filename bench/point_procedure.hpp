@@ -12,6 +12,7 @@
 #include "bench/ordered_stop.hpp"
 #include "bench/point_record.hpp"
 #include "bench/steady_state.hpp"
+#include "bench/uncertainty.hpp"
 #include "drivers/clock.hpp"
 #include "drivers/devices.hpp"
 
@@ -44,6 +45,8 @@ struct PointOptions {
   // the most a sample may come late without anything being wrong.
   double host_window_jitter_s = 0.5;
   double load_b1_Nms_per_rad = 2.0e-4;  // load machine friction B1G: P_m = T_L w + B1G w^2 (6.1)
+  // The type B inputs of the point's uncertainty budget (bench config "uncertainty").
+  drivers::UncertaintyConfig uncertainty;
   bool ordered_stop_after = true;
   // In a sweep the drives stay running between points: when the SynRM drive already runs, the
   // new setpoints are commanded together and the gate decides when the bench has settled.
@@ -94,6 +97,8 @@ class PointProcedure {
   // fault latched or a device read failed from the window's open until the record was complete.
   bool has_record() const { return has_record_; }
   const PointRecord& record() const { return record_; }
+  // The record's uncertainty budget (bench/uncertainty.hpp); set with the record.
+  const std::optional<PointBudget>& budget() const { return budget_; }
   // Why the procedure failed: which device call and what it said.
   const std::string& error() const { return error_; }
   // The drive could not hold the commanded speed while settling (see PointOptions).
@@ -148,6 +153,7 @@ class PointProcedure {
   bool angle_pending_ = false;     // spun up at the sensorless start angle; its own comes when loaded
   bool lock_seen_ = false;         // the drive's lock guard was seen not tripped during this point
   PointRecord record_;
+  std::optional<PointBudget> budget_;
   std::string error_;
 };
 

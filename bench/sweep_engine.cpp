@@ -39,6 +39,7 @@ SweepEngine::SweepEngine(drivers::BenchDevices devices, const SafetySupervisor& 
   options_.ordered_stop_after = false;
   options_.continue_running = true;
   options_.load_b1_Nms_per_rad = bench_.load_b1_Nms_per_rad;
+  options_.uncertainty = bench_.uncertainty;
   if (plan_.thermal.enabled)
     options_.thermal = PointOptions::Thermal{plan_.thermal.target_C, plan_.thermal.band_C,
                                              plan_.thermal.warmup_load_Nm, plan_.thermal.timeout_s};

@@ -52,6 +52,7 @@ class SweepSink {
 
 struct SweepBench {
   double load_b1_Nms_per_rad = 2.0e-4;  // the load machine's friction (bench calibration, 6.2)
+  drivers::UncertaintyConfig uncertainty;  // the points' type B budget inputs
 };
 
 class SweepEngine {

@@ -5,6 +5,9 @@
 
 #include <array>
 #include <set>
+#include <span>
+#include <string_view>
+#include <vector>
 #include <utility>
 
 #include "drivers/json_file.hpp"
@@ -100,7 +103,7 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
   BenchConfig c;
   if (!root.object()) return {std::nullopt, r.errors};
   root.reject_unknown({"time_scale", "poll_period_ms", "window_margin_s", "retries", "retry_budget_ms", "links",
-                       "devices", "limits", "setpoints", "calibration"});
+                       "devices", "limits", "setpoints", "calibration", "uncertainty"});
   if (auto v = number(root["time_scale"], 0.001, 1000)) c.time_scale = *v;
   if (auto v = number(root["poll_period_ms"], 1, 10000)) c.poll_period_ms = *v;
   if (auto v = number(root["window_margin_s"], 0, 3600)) c.window_margin_s = *v;
@@ -126,6 +129,33 @@ BenchConfigResult parse_bench_config(const json& doc, const std::filesystem::pat
   if (const JsonNode cal = root["calibration"]; cal.object()) {
     cal.reject_unknown({"load_b1_Nms_per_rad"});
     c.calibration.load_b1_Nms_per_rad = number(cal["load_b1_Nms_per_rad"], 0, 1);
+  }
+  if (const JsonNode un = root["uncertainty"]; un.object()) {
+    // Each a standard uncertainty (k = 1) in the unit its name ends in; docs/uncertainty.md.
+    UncertaintyConfig& u = c.uncertainty;
+    const std::pair<const char*, double*> keys[] = {
+        {"vfc_f0_u_Hz", &u.vfc_f0_u_Hz},
+        {"vfc_kf_u_pct", &u.vfc_kf_u_pct},
+        {"meter_clock_u_ppm", &u.meter_clock_u_ppm},
+        {"dc_sensor_gain_u_pct", &u.dc_sensor_gain_u_pct},
+        {"dc_sensor_offset_u_A", &u.dc_sensor_offset_u_A},
+        {"power_meter_u_pct", &u.power_meter_u_pct},
+        {"udc_gain_u_pct", &u.udc_gain_u_pct},
+        {"udc_offset_u_V", &u.udc_offset_u_V},
+        {"torque_gain_u_pct", &u.torque_gain_u_pct},
+        {"torque_offset_u_Nm", &u.torque_offset_u_Nm},
+        {"load_b1_u_Nms_per_rad", &u.load_b1_u_Nms_per_rad},
+        {"im_gain_u_pct", &u.im_gain_u_pct},
+        {"encoder_counts_per_rev", &u.encoder_counts_per_rev}};
+    std::vector<std::string_view> names;
+    for (const auto& [k, p] : keys) names.emplace_back(k);
+    un.reject_unknown(std::span<const std::string_view>(names));
+    for (const auto& [k, p] : keys) {
+      const std::string key = k;
+      const bool pct = key.ends_with("_pct"), ppm = key.ends_with("_ppm"), counts = key == "encoder_counts_per_rev";
+      const double hi = pct ? 100.0 : ppm ? 1.0e5 : counts ? 1.0e9 : key == "vfc_f0_u_Hz" ? 1.0e6 : 1.0e3;
+      if (auto v = number(un[k], counts ? 1.0 : 0.0, hi)) *p = *v;
+    }
   }
 
   const JsonNode links = root["links"];

@@ -3,6 +3,7 @@
 // link's timeouts. `synbench point --bench FILE` reads it; docs/bench-config.md is its schema.
 #pragma once
 
+#include "drivers/uncertainty_config.hpp"
 #include "drivers/json_fwd.hpp"
 
 #include <cstdint>
@@ -55,6 +56,7 @@ struct BenchConfig {
   BenchLimitsConfig limits;            // the safety supervisor's trips
   BenchSetpointsConfig setpoints;      // what an operator may command
   BenchCalibrationConfig calibration;
+  UncertaintyConfig uncertainty;       // a point's type B budget inputs; defaults where not given
 
   const DeviceConfig& device(DeviceKind k) const;
   // Whether the devices run on the in-process twin (all of them, or none: a config that

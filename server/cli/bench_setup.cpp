@@ -125,6 +125,7 @@ app::BenchDescription bench_description(const drivers::BenchConfig& config) {
   d.max_speed_rpm = config.setpoints.max_speed_rpm.value_or(std::min(d.max_speed_rpm, d.limits.max_speed_rpm));
   if (config.setpoints.max_load_Nm) d.max_load_Nm = *config.setpoints.max_load_Nm;
   if (config.calibration.load_b1_Nms_per_rad) d.load_b1_Nms_per_rad = *config.calibration.load_b1_Nms_per_rad;
+  d.uncertainty = config.uncertainty;
   d.poll_period_s = config.poll_period_ms / 1000;
   return d;
 }

@@ -50,6 +50,9 @@ options:
                      --config, --seed, --udc-V and --temp-C apply only when its links are the
                      in-process twin (give them to `synbench emulate` otherwise)
   --json             print the record as one JSON object (field names: docs/record.md)
+  --budget           also print the point's uncertainty budget (GUM, k = 1: every component,
+                     its source, u_i, sensitivity and contributions; docs/uncertainty.md); with
+                     --json an object {"record": ..., "budget": ...}
   --help             this text
 
 exit status: 0 measured, 1 failed, 2 bad input, 3 a fault latched during the point
@@ -80,12 +83,12 @@ double required(const Args& a, const std::string& flag) {
 int point_command(const std::vector<std::string>& argv) {
   emulator::TwinConfig config;
   bench::PointRequest req;
-  bool json = false;
+  bool json = false, budget = false;
   std::optional<drivers::BenchConfig> bench_config;
   std::optional<drivers::BenchProfiles> profiles;
   bool bench_config_given = false;
   try {
-    Args a(argv, {"--json", "--help"},
+    Args a(argv, {"--json", "--budget", "--help"},
            {"--speed-rpm", "--load-Nm", "--angle-deg", "--pwm", "--estimator", "--udc-V",
             "--window-s", "--temp-C", "--config", "--seed", "--bench"});
     if (a.has("--help")) {
@@ -94,6 +97,7 @@ int point_command(const std::vector<std::string>& argv) {
     }
     if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
     json = a.has("--json");
+    budget = a.has("--budget");
     if (auto file = a.text("--config")) config = emulator::load_twin_config_file(*file);
 
     req.speed_rpm = required(a, "--speed-rpm");
@@ -161,6 +165,7 @@ int point_command(const std::vector<std::string>& argv) {
   const app::BenchDescription& bench = backend->description();
   bench::PointOptions options;
   options.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
+  options.uncertainty = bench.uncertainty;
   options.tick_s = bench.poll_period_s;
   // The same supervisor as the daemon's and a sweep's, on the bench's own limits.
   bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [](const std::string& kind, const std::string& m) {
@@ -180,12 +185,19 @@ int point_command(const std::vector<std::string>& argv) {
     std::cerr << backend->link_errors();
     return result.trip ? 3 : 1;
   }
-  if (json) {
+  if (json && budget) {
+    synbench::Json out = synbench::Json::object();
+    out["record"] = bench::to_json(proc.record());
+    out["budget"] = proc.budget() ? bench::to_json(*proc.budget()) : synbench::Json(nullptr);
+    std::cout << out.dump() << "\n";
+  } else if (json) {
     std::cout << bench::to_json(proc.record()).dump() << "\n";
   } else {
     std::cout << "operating point (" << (bench_config_given ? backend->links() : std::string("twin")) << ", " << bench_s
               << " s of bench time)\n"
               << bench::to_text(proc.record());
+    if (budget && proc.budget())
+      std::cout << "\nuncertainty budget (GUM, k = 1; docs/uncertainty.md)\n" << bench::to_text(*proc.budget());
   }
   if (proc.record().fault || result.trip) {
     std::cerr << "synbench point: "

@@ -267,6 +267,7 @@ int sweep_command(const std::vector<std::string>& argv) {
   ProgressPrinter printer(id, quiet, print_committed);
   app::SweepRunOptions run_options;
   run_options.calibration.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
+  run_options.calibration.uncertainty = bench.uncertainty;
   run_options.observer = &printer;
   // The same runner as the daemon's: the stricter of the bench's and the plan's limits.
   app::SweepRun run(backend->devices(), supervisor, store, id, *plan, std::move(stored), run_options);

@@ -97,6 +97,29 @@ TEST(BenchConfig, EveryProblemNamesItsField) {
   EXPECT_NE(e.find("/devices/load_drive/unit_id: 0 is outside"), std::string::npos) << e;
 }
 
+TEST(BenchConfig, TheUncertaintySectionOverridesItsDefaultsAndRefusesNonsense) {
+  {
+    const BenchConfigResult r = parse_bench_config(valid(), "/etc/synbench");
+    ASSERT_TRUE(r.config);
+    EXPECT_DOUBLE_EQ(r.config->uncertainty.meter_clock_u_ppm, UncertaintyConfig{}.meter_clock_u_ppm);
+  }
+  json d = valid();
+  d["uncertainty"] = json::parse(R"({"meter_clock_u_ppm": 20, "udc_gain_u_pct": 0.25, "encoder_counts_per_rev": 8192})");
+  const BenchConfigResult r = parse_bench_config(d, "/etc/synbench");
+  ASSERT_TRUE(r.config) << errors_of(d);
+  EXPECT_DOUBLE_EQ(r.config->uncertainty.meter_clock_u_ppm, 20);
+  EXPECT_DOUBLE_EQ(r.config->uncertainty.udc_gain_u_pct, 0.25);
+  EXPECT_DOUBLE_EQ(r.config->uncertainty.encoder_counts_per_rev, 8192);
+  EXPECT_DOUBLE_EQ(r.config->uncertainty.vfc_f0_u_Hz, UncertaintyConfig{}.vfc_f0_u_Hz);  // not given: default
+  d["uncertainty"] = json::parse(R"({"udc_gain_u_pct": 101, "torque_offset_u_Nm": -1, "shunt_u_pct": 1,
+                                     "encoder_counts_per_rev": 0})");
+  const std::string e = errors_of(d);
+  EXPECT_NE(e.find("/uncertainty/udc_gain_u_pct: 101 is outside [0, 100]"), std::string::npos) << e;
+  EXPECT_NE(e.find("/uncertainty/torque_offset_u_Nm: -1 is outside"), std::string::npos) << e;
+  EXPECT_NE(e.find("/uncertainty/shunt_u_pct: unknown field"), std::string::npos) << e;
+  EXPECT_NE(e.find("/uncertainty/encoder_counts_per_rev: 0 is outside"), std::string::npos) << e;
+}
+
 TEST(BenchConfig, TheTwinIsAllOrNothing) {
   json d = valid();
   d["links"]["twin"] = {{"transport", "twin"}};

@@ -53,6 +53,61 @@ check(code == 0 and rec2["pwm"] == "aspwm" and abs(rec2["temp_C"] - 30) < 1 and 
 code, out, _ = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "52")
 check(code == 0 and "pdcm_W" in out and "truth" in out, "readable output")
 
+# --- the uncertainty budget (docs/uncertainty.md) -----------------------------------------------
+U_FIELDS = {"pdcm_u_W": ("combined", "pdcm_W"), "pdcg_u_W": ("combined", "pdcg_W"), "pm_u_W": ("combined", "pm_W"),
+            "efficiency_u": ("combined", "efficiency"), "im_u_A": ("combined", "im_A"),
+            "pdcm_u_repeat_W": ("repeat", "pdcm_W"), "efficiency_u_repeat": ("repeat", "efficiency"),
+            "im_u_repeat_A": ("repeat", "im_A")}
+BUDGET_NAMES = ["I_dcM type A", "VFC count quantisation (M)", "meter clock (gate time) (M)", "VFC f0 calibration (M)",
+                "VFC Kf calibration (M)", "DC current sensor gain (M)", "DC current sensor offset (M)", "U_dc gain",
+                "U_dc offset", "T_L type A", "torque gain", "torque offset", "speed type A", "encoder quantisation",
+                "B1G", "I_m type A", "I_m current sensor gain"]
+
+
+def check_budget(name, rec, budget):
+    """The record's u fields are the budget's combined and repeat values; each combined value is
+    the root sum of squares of its contributions (GUM 5.1.2), and null only when a component it
+    needs is unavailable, which the budget then says."""
+    comps = {c["name"]: c for c in budget["components"]}
+    check(all(n in comps for n in BUDGET_NAMES), f"{name}: every budget component ({sorted(set(BUDGET_NAMES) - set(comps))} missing)")
+    check(all(c["source"] and c["type"] in ("A", "B") and c["unit"] for c in comps.values()),
+          f"{name}: each component has its type, source and unit")
+    for field, (part, out) in U_FIELDS.items():
+        check(rec[field] == budget[part][out], f"{name}: record {field} {rec[field]} is the budget's {part} {out}")
+    for part in ("combined", "repeat"):
+        for out in ("pdcm_W", "pm_W", "efficiency", "im_A"):
+            entering = [c for c in comps.values() if out in c["sensitivity"] and (part == "combined" or c["repeat"])]
+            if all(c["u"] is not None for c in entering):
+                rss = sum(c["contribution"][out] ** 2 for c in entering) ** 0.5
+                check(budget[part][out] is not None and abs(budget[part][out] - rss) <= 1e-9 * rss + 1e-15,
+                      f"{name}: {part} u({out}) {budget[part][out]} = root sum of squares {rss}")
+                for c in entering:
+                    check(abs(c["contribution"][out] - abs(c["sensitivity"][out] * c["u"])) <= 1e-12 * c["contribution"][out] + 1e-18,
+                          f"{name}: contribution of {c['name']} to {out} is |c u|")
+            else:
+                missing = [c["name"] for c in entering if c["u"] is None]
+                check(budget[part][out] is None and all(any(m in n for n in budget["notes"]) for m in missing),
+                      f"{name}: {part} u({out}) null, the notes say why ({missing})")
+    # Type B values from the defaults (docs/uncertainty.md): the count quantisation over a 1 s gate
+    # at Kf = 100 kHz/A, and U_dc's 0.5 % gain.
+    q = comps["VFC count quantisation (M)"]["u"]
+    check(abs(q - 1 / (6 ** 0.5 * 100e3 * rec["window_s"])) < 1e-12, f"{name}: VFC quantisation {q} A")
+    check(abs(comps["U_dc gain"]["u"] - 0.005 * rec["udc_V"]) < 1e-9, f"{name}: U_dc gain {comps['U_dc gain']['u']} V")
+
+
+code, out, err = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "56", "--budget", "--json")
+check(code == 0, f"point --budget --json exits 0 ({err.strip()[:200]})")
+both = json.loads(out)
+check(list(both.keys()) == ["record", "budget"] and list(both["record"].keys()) == RECORD_FIELDS,
+      "point --budget --json: the record and its budget")
+check_budget("twin", both["record"], both["budget"])
+code, out, _ = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "56", "--budget")
+check(code == 0 and "uncertainty budget (GUM, k = 1" in out and "combined u (k = 1)" in out
+      and "VFC count quantisation (M)" in out and "[assumed]" in out and "of which repeat" in out,
+      "point --budget prints the budget table")
+code, out, _ = run("point", "--speed-rpm", "700", "--load-Nm", "2.5", "--angle-deg", "56", "--json")
+check(code == 0 and "budget" not in json.loads(out), "without --budget the JSON is the record alone")
+
 bad = [
     (["--speed-rpm", "5000", "--load-Nm", "1", "--angle-deg", "50"], "--speed-rpm"),
     (["--speed-rpm", "0", "--load-Nm", "1", "--angle-deg", "50"], "--speed-rpm"),

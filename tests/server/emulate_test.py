@@ -77,13 +77,13 @@ class SocatPair:
         self.p.wait(timeout=10)
 
 
-def bench_config(name, link):
+def bench_config(name, link, **extra):
     path = os.path.join(tmp, name + ".json")
     with open(path, "w") as f:
         # A generous window margin: on a loaded machine the twin may fall behind the bench's clock.
         json.dump({"time_scale": TIME_SCALE, "window_margin_s": 60, "links": {"emu": link},
                    "devices": {k: {"profile": "default", "link": "emu"}
-                               for k in ("synrm_drive", "load_drive", "vfc_meter")}}, f)
+                               for k in ("synrm_drive", "load_drive", "vfc_meter")}, **extra}, f)
     return path
 
 
@@ -239,14 +239,25 @@ def served_batches(name, link, host):
 
 
 emu = Emulator("--tcp", "127.0.0.1:0", *SCALED)
-cfg = bench_config("tcp", {"transport": "tcp", "host": "127.0.0.1", "port": emu.port, "response_timeout_ms": 200})
+# The bench config's "uncertainty" reaches the point's budget over Modbus (docs/uncertainty.md).
+cfg = bench_config("tcp", {"transport": "tcp", "host": "127.0.0.1", "port": emu.port, "response_timeout_ms": 200},
+                   uncertainty={"udc_gain_u_pct": 2.0, "torque_offset_u_Nm": 0.05})
 t0 = time.time()
-code, out, err = run("point", *POINT, "--bench", cfg, timeout=60)
+code, out, err = run("point", *POINT, "--bench", cfg, "--budget", timeout=60)
 wall = time.time() - t0
 check(code == 0, f"point over TCP ({wall:.2f} s wall): {err.strip()[:200]}")
 if code == 0:
-    same_record("tcp", json.loads(out))
+    rec, budget = json.loads(out)["record"], json.loads(out)["budget"]
+    same_record("tcp", rec)
     served_batches("tcp", ["-m", "tcp", "-p", str(emu.port)], "127.0.0.1")
+    comps = {c["name"]: c for c in budget["components"]}
+    check(abs(comps["U_dc gain"]["u"] - 0.02 * rec["udc_V"]) < 1e-6 and comps["torque offset"]["u"] == 0.05,
+          f"tcp: the bench config's uncertainty section in the budget ({comps['U_dc gain']['u']} V)")
+    check(rec["pdcm_u_W"] is not None and rec["pdcm_u_repeat_W"] is not None and rec["efficiency_u"] is not None,
+          f"tcp: the served batches give every uncertainty (pdcm_u_repeat_W {rec['pdcm_u_repeat_W']})")
+    check(rec["pdcm_u_W"] == budget["combined"]["pdcm_W"] and rec["pm_u_W"] == budget["combined"]["pm_W"]
+          and rec["efficiency_u_repeat"] == budget["repeat"]["efficiency"],
+          f"tcp: the record's u fields are its budget's (pdcm_u_W {rec['pdcm_u_W']})")
 code, emu_out, _ = emu.stop()
 print("  " + " | ".join(emu_out.strip().splitlines()[-2:]))
 
