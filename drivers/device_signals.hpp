@@ -12,6 +12,7 @@
 #include <string_view>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
 #include "drivers/devices.hpp"
 
@@ -115,15 +116,88 @@ inline constexpr SignalField<MeterReading> kMeterGateSignals[] = {
     {"idcg_A", &MeterReading::idcg_A},
 };
 
+// The calibration a gate meter computes its currents with, read with each gate's results.
+inline constexpr SignalField<MeterReading> kMeterCalibrationSignals[] = {
+    {"f0_Hz", &MeterReading::f0_Hz},
+    {"kf_Hz_per_A", &MeterReading::kf_Hz_per_A},
+};
+
 // A power meter's averages, sampled by the bench (meter power).
 inline constexpr SignalField<MeterReading> kMeterPowerMeans[] = {
     {"pdcm_W", &MeterReading::pdcm_W},
     {"pdcg_W", &MeterReading::pdcg_W},
 };
 
+// Array signals (a profile's "count"): a window's batches, one value per sub-window.
+template <class S>
+using ArrayMember = std::variant<std::vector<double> S::*, std::vector<std::uint64_t> S::*>;
+
+template <class S>
+struct ArrayField {
+  std::string_view signal;
+  ArrayMember<S> member;
+};
+
+inline constexpr ArrayField<SynrmWindow> kSynrmWindowArrays[] = {
+    {"window_batch_im_A", &SynrmWindow::batch_im_A},
+    {"window_batch_speed_meas_rpm", &SynrmWindow::batch_speed_meas_rpm},
+};
+
+inline constexpr ArrayField<LoadWindow> kLoadWindowArrays[] = {
+    {"window_batch_torque_Nm", &LoadWindow::batch_torque_Nm},
+};
+
+inline constexpr ArrayField<MeterReading> kMeterGateArrays[] = {
+    {"batch_counts_m", &MeterReading::batch_counts_m},
+    {"batch_counts_g", &MeterReading::batch_counts_g},
+};
+
+// A window the bench keeps: the telemetry signal whose polls, split into batches by time, give
+// each batch member (host_window.hpp).
+inline constexpr ArrayField<SynrmWindow> kSynrmHostBatches[] = {
+    {"im_A", &SynrmWindow::batch_im_A},
+    {"speed_rpm", &SynrmWindow::batch_speed_meas_rpm},
+};
+
+inline constexpr ArrayField<LoadWindow> kLoadHostBatches[] = {
+    {"torque_Nm", &LoadWindow::batch_torque_Nm},
+};
+
+// Sets an array member from the signal's values (counts rounded to whole pulses).
+template <class S>
+void assign(S& out, const ArrayMember<std::type_identity_t<S>>& member, const std::vector<double>& v) {
+  std::visit(
+      [&](auto m) {
+        auto& field = out.*m;
+        using T = typename std::remove_reference_t<decltype(field)>::value_type;
+        field.clear();
+        for (double x : v) field.push_back(std::is_same_v<T, double> ? static_cast<T>(x) : static_cast<T>(std::llround(x)));
+      },
+      member);
+}
+
+// The array member as the signal's numbers.
+template <class S>
+std::vector<double> numbers(const S& in, const ArrayMember<std::type_identity_t<S>>& member) {
+  return std::visit(
+      [&](auto m) {
+        std::vector<double> v;
+        for (const auto x : in.*m) v.push_back(static_cast<double>(x));
+        return v;
+      },
+      member);
+}
+
 template <class S, std::size_t N>
 const SignalField<S>* find_field(const SignalField<S> (&table)[N], std::string_view signal) {
   for (const SignalField<S>& f : table)
+    if (f.signal == signal) return &f;
+  return nullptr;
+}
+
+template <class S, std::size_t N>
+const ArrayField<S>* find_array(const ArrayField<S> (&table)[N], std::string_view signal) {
+  for (const ArrayField<S>& f : table)
     if (f.signal == signal) return &f;
   return nullptr;
 }

@@ -68,6 +68,7 @@ class Parser : public JsonReader {
   void enum_values(const SignalSpec& spec, const JsonNode& n, ProfileSignal& s);
   void heartbeat(const JsonNode& n, ProfileSignal& s);
   void bit_mask(const JsonNode& n, ProfileSignal& s);
+  void array_count(const SignalSpec& spec, const JsonNode& n, ProfileSignal& s);
   void otherwise(const SignalSpec& spec, const JsonNode& n, ProfileSignal& s);
   void reset_mode(const JsonNode& n, ProfileSignal& s);
   // Whether `value` fits the signal's encoding (and its field, for a masked signal).
@@ -78,7 +79,7 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const JsonNo
   if (!n.object("must be an object")) return std::nullopt;
   n.reject_unknown({"unit_id", "register", "address", "type", "word_order", "byte_order", "scale", "offset",
                   "unit", "access", "min", "max", "values", "period_ms", "timeout_ms", "bit", "mask", "otherwise",
-                  "reset"});
+                  "reset", "count"});
   const std::size_t errors_before = errors.size();
 
   ProfileSignal s;
@@ -111,12 +112,14 @@ std::optional<ProfileSignal> Parser::signal(const SignalSpec& spec, const JsonNo
     if (n.has("otherwise")) otherwise(spec, n, s);
   }
 
+  array_count(spec, n, s);
   if (address) {
     s.address = static_cast<std::uint16_t>(*address);
-    const std::size_t width = address_width(s.encoding.type);
+    const std::size_t width = address_width(s.encoding.type) * s.values_count();
     if (*address + static_cast<std::int64_t>(width) - 1 > 65535)
-      n["address"].fail(std::string(name(s.encoding.type)) + " at " + std::to_string(*address) +
-                                  " needs " + std::to_string(width) + " registers and runs past 65535");
+      n["address"].fail(std::string(name(s.encoding.type)) + (s.count ? " x " + std::to_string(s.count) : "") +
+                        " at " + std::to_string(*address) + " needs " + std::to_string(width) +
+                        " registers and runs past 65535");
   }
 
   const std::string expected_unit(spec.unit);
@@ -280,6 +283,26 @@ void Parser::enum_values(const SignalSpec& spec, const JsonNode& n, ProfileSigna
     }
   }
   std::sort(s.values.begin(), s.values.end(), [](const EnumValue& a, const EnumValue& b) { return a.value < b.value; });
+}
+
+// An array signal's "count": required on the catalogue's array signals, refused on the others;
+// whole registers only (no bits, no mask: each value has its own address).
+void Parser::array_count(const SignalSpec& spec, const JsonNode& n, ProfileSignal& s) {
+  if (!spec.array) {
+    if (n.has("count")) n["count"].fail(s.name + " is a single value; count applies to array signals only");
+    return;
+  }
+  if (!n.has("count")) {
+    n["count"].fail("required: " + s.name + " is an array of " + std::to_string(kMinArrayCount) + ".." +
+                    std::to_string(kMaxArrayCount) + " consecutive values");
+    return;
+  }
+  const auto count = n["count"].integer(kMinArrayCount, kMaxArrayCount);
+  if (!count) return;
+  s.count = static_cast<std::uint8_t>(*count);
+  if (is_bit_kind(s.kind)) n["register"].fail("an array needs holding or input registers");
+  for (const char* key : {"bit", "mask"})
+    if (n.has(key)) n[key].fail("does not apply to an array (each value has its own registers)");
 }
 
 void Parser::bit_mask(const JsonNode& n, ProfileSignal& s) {

@@ -87,13 +87,19 @@ struct ProfileSignal {
   std::string otherwise;        // enumerated: the label of any device number not in values
   FaultResetMode reset;         // fault_reset only
 
+  // An array signal's number of values (their addresses follow one another, each
+  // address_width(type) wide); 0 for a single value.
+  std::uint8_t count = 0;
+
   bool masked() const { return mask != 0; }
+  // How many values the signal carries: count, or 1.
+  std::size_t values_count() const { return count ? count : 1u; }
 
   bool readable() const { return access != Access::w; }
   bool writable() const { return access != Access::r; }
-  // Last address the signal occupies.
+  // Last address the signal occupies (an array's: its last value's).
   std::uint16_t last_address() const {
-    return static_cast<std::uint16_t>(address + address_width(encoding.type) - 1);
+    return static_cast<std::uint16_t>(address + address_width(encoding.type) * values_count() - 1);
   }
 };
 

@@ -74,7 +74,8 @@ void device_table(std::string& md, const DeviceProfile& p) {
                                     ? std::string(kNone)
                                     : format_number(e.scale) + " / " + format_number(e.offset);
     md += "| `" + s.name + "` | " + std::to_string(s.unit_id) + " | " + std::string(name(s.kind)) + " | " +
-          address(s) + " | " + std::string(name(e.type)) + " | " + order(e) + " | " + scaling + " | " +
+          address(s) + " | " + std::string(name(e.type)) + (s.count ? " x " + std::to_string(s.count) : "") +
+          " | " + order(e) + " | " + scaling + " | " +
           cell(s.unit) + " | " + std::string(name(s.access)) + " | " + limits(e) + " | " +
           std::string(name(s.role)) + " | " + cell(notes(p.kind, s)) + " |\n";
   }

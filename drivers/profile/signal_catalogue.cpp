@@ -73,6 +73,10 @@ constexpr SignalSpec kSynrm[] = {
     {"window_lock_lost_fraction", R::window_result, false, "", "fraction of samples the lock guard ran on the encoder, 0..1"},
     {"window_estimates_present", R::window_result, false, "",
      "which estimator fields this window has, bits: 1 position and speed errors, 2 Ld, 4 Lq, 8 Rs; an absent field reads 0 (without this signal all are taken as present)"},
+    {"window_batch_im_A", R::window_result, false, "A",
+     "array (count): means of the window's equal consecutive sub-windows (batches), in time order", {}, true},
+    {"window_batch_speed_meas_rpm", R::window_result, false, "rpm",
+     "array (count): speed from encoder counts over each batch, in time order", {}, true},
 };
 
 constexpr SignalSpec kLoad[] = {
@@ -93,6 +97,9 @@ constexpr SignalSpec kLoad[] = {
     {"window_sequence", R::window_sequence, false, "", "increments (mod 65536) per closed window"},
     {"window_samples", R::window_result, false, "", "control periods accumulated"},
     {"window_torque_Nm", R::window_result, false, "Nm", "mean braking torque"},
+    {"window_batch_torque_Nm", R::window_result, false, "Nm",
+     "array (count): mean braking torque over each of the window's equal consecutive sub-windows (batches), in time order",
+     {}, true},
 };
 
 constexpr SignalSpec kMeter[] = {
@@ -105,6 +112,12 @@ constexpr SignalSpec kMeter[] = {
     {"gate_s", R::window_result, false, "s", "measured gate duration"},
     {"idcm_A", R::window_result, false, "A", "motor-side DC current, (counts_m / gate_s - f0_Hz) / kf_Hz_per_A"},
     {"idcg_A", R::window_result, false, "A", "generator-side DC current, (counts_g / gate_s - f0_Hz) / kf_Hz_per_A"},
+    {"batch_counts_m", R::window_result, false, "",
+     "array (count): motor-side VFC pulses in each of the gate's equal consecutive sub-gates, in time order (they sum to counts_m)",
+     {}, true},
+    {"batch_counts_g", R::window_result, false, "",
+     "array (count): generator-side VFC pulses in each of the gate's equal consecutive sub-gates, in time order (they sum to counts_g)",
+     {}, true},
     {"f0_Hz", R::calibration, false, "Hz", "nominal converter frequency at zero current"},
     {"kf_Hz_per_A", R::calibration, false, "Hz/A", "nominal converter gain"},
     {"total_m", R::telemetry, false, "",

@@ -36,7 +36,12 @@ struct SignalSpec {
   // An enumerated signal's labels, indexed by the bench's code (state: labels[3] == "faulted").
   // A profile's "values" map these labels to the device's own numbers.
   std::span<const std::string_view> labels = {};
+  // An array of "count" consecutive values (2..64, the profile says how many): a window's batch
+  // means. A profile must give an array signal a count and may not give one to any other.
+  bool array = false;
 };
+
+inline constexpr int kMinArrayCount = 2, kMaxArrayCount = 64;
 
 inline constexpr std::array<DeviceKind, 3> kDeviceKinds{DeviceKind::synrm_drive, DeviceKind::load_drive,
                                                          DeviceKind::vfc_meter};

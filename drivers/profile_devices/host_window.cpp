@@ -2,6 +2,7 @@
 #include "drivers/profile_devices/host_window.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "drivers/error.hpp"
 
@@ -23,7 +24,10 @@ std::error_code HostWindow::arm() {
 std::error_code HostWindow::open(double now_s, double window_s) {
   if (state_ == State::open) return make_error_code(errc::busy);
   state_ = State::open;
+  open_s_ = now_s;
   end_s_ = now_s + window_s;
+  batch_samples_.assign(kHostWindowBatches, 0);
+  batch_sums_.assign(kHostWindowBatches * stats_.size(), 0.0);
   next_s_ = now_s;
   samples_ = 0;
   longest_gap_s_ = 0;
@@ -44,6 +48,12 @@ std::error_code HostWindow::sample(double now_s) {
       s.first_nonzero_device = plan_.device_value(i);
     }
   }
+  // The batch of the sample's time: equal spans of the window from its open to its close.
+  const double span_s = (end_s_ - open_s_) / static_cast<double>(kHostWindowBatches);
+  const double b = span_s > 0 ? std::floor((now_s - open_s_ + kDueSlack_s) / span_s) : 0.0;
+  const auto batch = static_cast<std::size_t>(std::clamp(b, 0.0, static_cast<double>(kHostWindowBatches - 1)));
+  ++batch_samples_[batch];
+  for (std::size_t i = 0; i < stats_.size(); ++i) batch_sums_[batch * stats_.size() + i] += values_[i];
   if (samples_ == 0) first_s_ = now_s;
   if (samples_ > 0) longest_gap_s_ = std::max(longest_gap_s_, now_s - last_s_);
   last_s_ = now_s;
@@ -74,6 +84,16 @@ void HostWindow::expire() {
 
 double HostWindow::next_due_s() const {
   return state_ == State::open ? std::min(next_s_, end_s_) : std::numeric_limits<double>::infinity();
+}
+
+std::vector<double> HostWindow::batch_means(std::size_t i) const {
+  std::vector<double> means;
+  if (samples_ < kHostPollsPerBatch * kHostWindowBatches || i >= stats_.size()) return means;
+  for (std::size_t k = 0; k < kHostWindowBatches; ++k) {
+    if (batch_samples_[k] == 0) return {};
+    means.push_back(batch_sums_[k * stats_.size() + i] / batch_samples_[k]);
+  }
+  return means;
 }
 
 std::error_code HostWindow::result() const {

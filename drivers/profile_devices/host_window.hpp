@@ -16,6 +16,12 @@
 
 namespace synbench::drivers {
 
+// The batches a host window splits its polls into by time (the drives' firmware keeps
+// firmware.window_batches; the bench's own count here), and the polls it needs per batch on
+// average before it keeps any: fewer leave a batch's mean to one or two polls.
+inline constexpr std::size_t kHostWindowBatches = 10;
+inline constexpr std::size_t kHostPollsPerBatch = 2;
+
 class HostWindow final : public WindowSource {
  public:
   // `plan` must outlive the window; `period_s` is the profile's poll_period_ms.
@@ -43,6 +49,10 @@ class HostWindow final : public WindowSource {
   // the device's own number behind it (ReadPlan::device_value: the raw code of an unknown fault).
   double first_nonzero(std::size_t i) const { return stats_[i].first_nonzero; }
   double first_nonzero_device(std::size_t i) const { return stats_[i].first_nonzero_device; }
+  // The means of the plan's i-th signal over the window's kHostWindowBatches equal consecutive
+  // spans of time, in time order (a sample at the close goes with the last); empty with fewer
+  // than kHostPollsPerBatch x kHostWindowBatches samples, or when a span has none.
+  std::vector<double> batch_means(std::size_t i) const;
   double period_s() const { return period_s_; }
   // The longest time between two samples (0 with fewer than two): a bench that stopped polling
   // (a frozen or starved master) leaves a gap no average over the window can see.
@@ -60,7 +70,10 @@ class HostWindow final : public WindowSource {
   const ReadPlan& plan_;
   double period_s_;
   State state_ = State::never;
-  double end_s_ = 0, next_s_ = 0, first_s_ = 0, last_s_ = 0, longest_gap_s_ = 0;
+  double open_s_ = 0, end_s_ = 0, next_s_ = 0, first_s_ = 0, last_s_ = 0, longest_gap_s_ = 0;
+  // Per batch: the samples taken in it and each signal's sum (batch-major).
+  std::vector<std::uint32_t> batch_samples_;
+  std::vector<double> batch_sums_;
   std::uint32_t samples_ = 0;
   std::vector<Stats> stats_;
   std::vector<double> values_;

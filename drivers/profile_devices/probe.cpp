@@ -80,7 +80,7 @@ std::vector<ProbeRow> probe_device(RegisterBus& bus, const DeviceProfile& profil
     row.signal = s.name;
     row.table = s.kind;
     row.address = s.address;
-    row.count = static_cast<std::uint16_t>(is_bit_kind(s.kind) ? 1 : address_width(s.encoding.type));
+    row.count = static_cast<std::uint16_t>(is_bit_kind(s.kind) ? 1 : address_width(s.encoding.type) * s.values_count());
     row.unit_id = s.unit_id;
     row.unit = s.unit;
     const std::string_view name = s.name;

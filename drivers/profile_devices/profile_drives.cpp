@@ -55,6 +55,37 @@ void assign_means(S& out, const SignalField<S> (&table)[N], const ReadPlan& plan
   }
 }
 
+// The plan's names and every array signal of `arrays` after them (read in the same requests
+// where the map puts them next to the others).
+template <class S>
+std::vector<std::string_view> with_arrays(std::vector<std::string_view> names, std::span<const ArrayField<S>> arrays) {
+  for (const ArrayField<S>& f : arrays) names.push_back(f.signal);
+  return names;
+}
+
+// Every array of `arrays` the plan holds, from its last read; those it lacks stay empty, and so
+// does an array of zeros: a window the device kept no batches of (shorter than its batches).
+template <class S>
+std::error_code assign_arrays(S& out, std::span<const ArrayField<S>> arrays, const ReadPlan& plan, SignalIo& io) {
+  for (const ArrayField<S>& f : arrays) {
+    if (!plan.present(f.signal)) continue;
+    std::vector<double> v;
+    if (auto ec = io.read_array(plan, f.signal, v)) return ec;
+    if (std::any_of(v.begin(), v.end(), [](double x) { return x != 0; })) assign(out, f.member, v);
+  }
+  return {};
+}
+
+// The batch means a host window kept of each telemetry signal into its array member (empty
+// when the window had too few polls for batches).
+template <class S>
+void assign_host_batches(S& out, std::span<const ArrayField<S>> batches, const ReadPlan& plan, const HostWindow& h) {
+  for (const ArrayField<S>& f : batches) {
+    const std::size_t i = plan.index(f.signal);
+    if (plan.present(i)) assign(out, f.member, h.batch_means(i));
+  }
+}
+
 // What every host-kept window reports of its own keeping.
 template <class W>
 void keep_by_host(W& w, const HostWindow& h) {
@@ -68,19 +99,22 @@ void keep_by_host(W& w, const HostWindow& h) {
 // SynRM drive (which has more to read) makes the same way.
 template <class W, std::size_t NM, std::size_t NR>
 std::error_code read_window_result(W& out, const HostWindow* host, double W::*span,
-                                   const SignalField<W> (&means)[NM], const ReadPlan& polled,
-                                   const SignalField<W> (&registers)[NR], const ReadPlan& plan,
-                                   WindowChannel& channel) {
+                                   const SignalField<W> (&means)[NM], std::span<const ArrayField<W>> batches,
+                                   const ReadPlan& polled, const SignalField<W> (&registers)[NR],
+                                   std::span<const ArrayField<W>> arrays, const ReadPlan& plan,
+                                   WindowChannel& channel, SignalIo& io) {
   W w;
   if (host) {
     if (auto ec = host->result()) return ec;
     keep_by_host(w, *host);
     w.*span = host->span_s();
     assign_means(w, means, polled, *host);
+    assign_host_batches(w, batches, polled, *host);
   } else {
     std::vector<double> v(plan.size());
     if (auto ec = channel.read_results(plan, v)) return ec;
     assign_read(w, registers, plan, v);
+    if (auto ec = assign_arrays(w, arrays, plan, io)) return ec;
   }
   out = w;
   return {};
@@ -152,7 +186,8 @@ HostWindow* ProfileDevice::host_window_over(const ReadPlan& plan) {
 ProfileSynrmDrive::ProfileSynrmDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::synrm_drive), std::move(profile))),
       telemetry_(this->profile(), names_of(kSynrmTelemetrySignals)),
-      window_(this->profile(), names_of(kSynrmWindowSignals, {"window_status", "window_sequence"}, not_estimate)),
+      window_(this->profile(), with_arrays(names_of(kSynrmWindowSignals, {"window_status", "window_sequence"}, not_estimate),
+                                           std::span<const ArrayField<SynrmWindow>>(kSynrmWindowArrays))),
       estimator_window_(this->profile(), names_of(kSynrmWindowSignals, {"window_estimates_present"}, is_estimate)),
       host_(host_window_over(telemetry_)) {}
 
@@ -200,6 +235,7 @@ std::error_code ProfileSynrmDrive::read_window(SynrmWindow& out) {
   if (auto ec = window().read_results(window_, v)) return ec;
   SynrmWindow w;
   assign_read(w, kSynrmWindowSignals, window_, v, not_estimate);
+  if (auto ec = assign_arrays(w, std::span<const ArrayField<SynrmWindow>>(kSynrmWindowArrays), window_, io())) return ec;
   w.fault_code_raw = raw_code(w.fault, window_.device_value(window_.index("window_fault_code")));
   if (estimator_ != Estimator::encoder) {
     // Read after the sequence check: the next window cannot open before this bench starts it.
@@ -230,6 +266,7 @@ std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
   assign(w, &SynrmWindow::fault, h.first_nonzero(fault));
   w.fault_code_raw = raw_code(w.fault, h.first_nonzero_device(fault));
   assign_means(w, kSynrmHostMeans, telemetry_, h);
+  assign_host_batches(w, std::span<const ArrayField<SynrmWindow>>(kSynrmHostBatches), telemetry_, h);
   const std::size_t pos_err = telemetry_.index("pos_err_deg");
   if (estimator_ != Estimator::encoder && telemetry_.present(pos_err)) {
     w.pos_err_min_deg = h.min(pos_err);
@@ -245,7 +282,8 @@ std::error_code ProfileSynrmDrive::read_host_window(SynrmWindow& out) {
 ProfileLoadDrive::ProfileLoadDrive(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::load_drive), std::move(profile))),
       telemetry_(this->profile(), names_of(kLoadTelemetrySignals)),
-      window_(this->profile(), names_of(kLoadWindowSignals, {"window_status", "window_sequence"})),
+      window_(this->profile(), with_arrays(names_of(kLoadWindowSignals, {"window_status", "window_sequence"}),
+                                           std::span<const ArrayField<LoadWindow>>(kLoadWindowArrays))),
       host_(host_window_over(telemetry_)) {}
 
 std::error_code ProfileLoadDrive::enable(bool on) { return io().write("enable", on ? 1 : 0); }
@@ -264,16 +302,19 @@ std::error_code ProfileLoadDrive::read(LoadTelemetry& out) {
 }
 
 std::error_code ProfileLoadDrive::read_window(LoadWindow& out) {
-  return read_window_result(out, host_, &LoadWindow::window_s, kLoadHostMeans, telemetry_, kLoadWindowSignals,
-                            window_, window());
+  return read_window_result(out, host_, &LoadWindow::window_s, kLoadHostMeans,
+                            std::span<const ArrayField<LoadWindow>>(kLoadHostBatches), telemetry_, kLoadWindowSignals,
+                            std::span<const ArrayField<LoadWindow>>(kLoadWindowArrays), window_, window(), io());
 }
 
 // --- VFC meter -----------------------------------------------------------------------------
 
 ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
     : ProfileDevice(bus, (require_kind(profile, DeviceKind::vfc_meter), std::move(profile))),
-      gate_(this->profile(), names_of(kMeterGateSignals, {"gate_status", "gate_sequence"})),
-      power_(this->profile(), names_of(kMeterPowerMeans)) {
+      gate_(this->profile(), with_arrays(names_of(kMeterGateSignals, {"gate_status", "gate_sequence"}),
+                                         std::span<const ArrayField<MeterReading>>(kMeterGateArrays))),
+      power_(this->profile(), names_of(kMeterPowerMeans)),
+      calibration_(this->profile(), names_of(kMeterCalibrationSignals)) {
   switch (this->profile().meter) {
     case MeterKind::gate: break;
     case MeterKind::totalizer: {
@@ -288,8 +329,20 @@ ProfileMeter::ProfileMeter(RegisterBus& bus, DeviceProfile profile)
 
 std::error_code ProfileMeter::read(MeterReading& out) {
   if (totalizer_) return totalizer_->read(out);
-  return read_window_result(out, host_, &MeterReading::gate_s, kMeterPowerMeans, power_, kMeterGateSignals, gate_,
-                            window());
+  // A power meter's polls keep no batches: MeterReading has batches of VFC counts only.
+  MeterReading m;
+  if (auto ec = read_window_result(m, host_, &MeterReading::gate_s, kMeterPowerMeans, {}, power_, kMeterGateSignals,
+                                   std::span<const ArrayField<MeterReading>>(kMeterGateArrays), gate_, window(), io()))
+    return ec;
+  // A gate's currents come from the meter's calibration: the nominal f0 and Kf with them (a
+  // profile without the calibration signals leaves them 0).
+  if (!host_ && calibration_.requests() > 0) {
+    std::vector<double> v(calibration_.size());
+    if (auto ec = io().read(calibration_, v)) return ec;
+    assign_read(m, kMeterCalibrationSignals, calibration_, v);
+  }
+  out = m;
+  return {};
 }
 
 }  // namespace synbench::drivers

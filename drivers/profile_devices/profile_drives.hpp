@@ -117,7 +117,7 @@ class ProfileMeter final : public PowerMeter, public ProfileDevice {
   std::string error_detail() const override { return device_error(); }
 
  private:
-  ReadPlan gate_, power_;
+  ReadPlan gate_, power_, calibration_;
   TotalizerWindow* totalizer_ = nullptr;
   HostWindow* host_ = nullptr;  // meter power
 };

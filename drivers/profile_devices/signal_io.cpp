@@ -132,14 +132,15 @@ std::error_code SignalIo::fail(std::error_code ec, const ProfileSignal* s, std::
   return ec;
 }
 
-std::error_code SignalIo::decode(const ProfileSignal& s, std::size_t at, double& bench_value, double& device_value) {
+std::error_code SignalIo::decode(const ProfileSignal& s, std::span<const std::uint16_t> all_words, std::size_t at,
+                                 double& bench_value, double& device_value) {
   if (is_bit_kind(s.kind)) {
     bool on = false;
     if (auto ec = decode_bit(bits_[at], on))
       return fail(ec, &s, "raw " + std::to_string(bits_[at]) + ": a bit reads 0 or 1");
     device_value = on ? 1.0 : 0.0;
   } else {
-    const auto words = std::span<const std::uint16_t>(words_).subspan(at, address_width(s.encoding.type));
+    const auto words = all_words.subspan(at, address_width(s.encoding.type));
     RegisterEncoding e = s.encoding;
     // A fault code is never out of range: a code the profile has no label for is a fault too.
     if (is_fault_code(s)) {
@@ -151,7 +152,7 @@ std::error_code SignalIo::decode(const ProfileSignal& s, std::size_t at, double&
   }
   if (auto ec = to_bench_code(profile_.kind, s, device_value, bench_value)) {
     const std::size_t n = is_bit_kind(s.kind) ? 0 : address_width(s.encoding.type);
-    return fail(ec, &s, (n ? "raw " + hex_words(std::span<const std::uint16_t>(words_).subspan(at, n)) + ": " : "") +
+    return fail(ec, &s, (n ? "raw " + hex_words(all_words.subspan(at, n)) + ": " : "") +
                             "device code " + format_number(device_value) + " has no label and no \"otherwise\"");
   }
   return {};
@@ -181,10 +182,29 @@ std::error_code SignalIo::read(const ReadPlan& plan, std::span<double> values) {
       continue;
     }
     const std::size_t at = plan.requests_[slot.request].buffer_offset + slot.offset;
-    if (auto ec = decode(*slot.signal, at, values[i], device_values_[i])) return ec;
+    if (auto ec = decode(*slot.signal, words_, at, values[i], device_values_[i])) return ec;
   }
   plan.device_values_ = device_values_;
+  plan.last_words_ = words_;
   last_error_.clear();
+  return {};
+}
+
+std::error_code SignalIo::read_array(const ReadPlan& plan, std::string_view signal, std::vector<double>& values) {
+  const std::size_t i = plan.index(signal);
+  if (!plan.present(i) || is_bit_kind(plan.slots_[i].signal->kind)) return make_error_code(errc::not_supported);
+  const ProfileSignal& s = *plan.slots_[i].signal;
+  const std::size_t at = plan.requests_[plan.slots_[i].request].buffer_offset + plan.slots_[i].offset;
+  const std::size_t width = address_width(s.encoding.type);
+  if (plan.last_words_.size() < at + width * s.values_count()) return make_error_code(errc::not_ready);
+  values.assign(s.values_count(), 0.0);
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    double device_value = 0;
+    if (auto ec = decode(s, plan.last_words_, at + k * width, values[k], device_value)) {
+      last_error_ += " (value " + std::to_string(k) + " of " + std::to_string(values.size()) + ")";
+      return ec;
+    }
+  }
   return {};
 }
 

@@ -62,6 +62,7 @@ class ReadPlan {
   std::vector<std::string> names_;
   std::size_t words_ = 0;  // buffer sizes
   mutable std::vector<double> device_values_;  // of the last successful read
+  mutable std::vector<std::uint16_t> last_words_;  // of the last successful read (arrays)
 };
 
 class SignalIo {
@@ -93,6 +94,10 @@ class SignalIo {
   // On error `values` is unspecified. A masked signal reads its bits of the register; a fault
   // code is never out of range (a code without a label reads Fault::unknown).
   std::error_code read(const ReadPlan& plan, std::span<double> values);
+  // The values of an array signal of the plan (a profile's "count") at the plan's last
+  // successful read, in engineering units, element 0 first; read() gives only element 0.
+  // errc::not_supported when the profile does not map it; a value outside its limits as read().
+  std::error_code read_array(const ReadPlan& plan, std::string_view signal, std::vector<double>& values);
   // Encodes with the signal's limits (errc::invalid_argument outside them) and writes. A masked
   // signal is a read-modify-write of its register: the other signals' bits are kept.
   // errc::not_supported when the profile does not map the signal.
@@ -111,7 +116,8 @@ class SignalIo {
   template <class Request>
   std::error_code with_retries(bool idempotent, Request&& request);
   // Decodes one signal of a completed read; on failure sets last_error_.
-  std::error_code decode(const ProfileSignal& s, std::size_t at, double& bench_value, double& device_value);
+  std::error_code decode(const ProfileSignal& s, std::span<const std::uint16_t> words, std::size_t at,
+                         double& bench_value, double& device_value);
   std::error_code write(std::string_view signal, double value, bool repeat);
   std::error_code write_masked(const ProfileSignal& s, double device_value, bool idempotent);
   std::error_code fail(std::error_code ec, const ProfileSignal* s, std::string what);

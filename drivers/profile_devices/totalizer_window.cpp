@@ -76,6 +76,8 @@ std::error_code TotalizerWindow::read(MeterReading& out) const {
   m.counts_m = counter_difference(start_[0], end_[0], range_[0]);
   m.counts_g = counter_difference(start_[1], end_[1], range_[1]);
   m.gate_s = static_cast<double>(ticks) / p.time_base_Hz;
+  m.f0_Hz = p.f0_Hz;
+  m.kf_Hz_per_A = p.kf_Hz_per_A;
   m.idcm_A = (static_cast<double>(m.counts_m) / m.gate_s - p.f0_Hz) / p.kf_Hz_per_A;
   m.idcg_A = (static_cast<double>(m.counts_g) / m.gate_s - p.f0_Hz) / p.kf_Hz_per_A;
   out = m;

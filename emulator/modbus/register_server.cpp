@@ -30,8 +30,19 @@ std::size_t width(const drivers::ProfileSignal& s) { return drivers::address_wid
 RegisterServer::RegisterServer(std::vector<drivers::DeviceProfile> profiles, SignalProvider& provider)
     : profiles_(std::move(profiles)), provider_(provider) {
   for (const drivers::DeviceProfile& p : profiles_)
-    for (const drivers::ProfileSignal& s : p.signals)
-      tables_[{s.unit_id, s.kind}].push_back(Entry{&s, p.kind, false, std::nullopt, served_codes(p, s).by_code});
+    for (const drivers::ProfileSignal& s : p.signals) {
+      if (!s.count) {
+        tables_[{s.unit_id, s.kind}].push_back(Entry{&s, p.kind, false, std::nullopt, served_codes(p, s).by_code});
+        continue;
+      }
+      for (std::size_t k = 0; k < s.count; ++k) {
+        drivers::ProfileSignal& e = elements_.emplace_back(s);
+        e.count = 0;
+        e.address = static_cast<std::uint16_t>(s.address + k * width(s));
+        tables_[{s.unit_id, s.kind}].push_back(
+            Entry{&e, p.kind, false, std::nullopt, served_codes(p, s).by_code, static_cast<int>(k)});
+      }
+    }
   for (auto& [key, t] : tables_)
     std::sort(t.begin(), t.end(), [](const Entry& a, const Entry& b) { return a.signal->address < b.signal->address; });
 }
@@ -74,7 +85,9 @@ std::array<std::uint16_t, 2> RegisterServer::raw(Entry& e) {
   const bool self_clearing =
       (s.role == drivers::SignalRole::fault_reset && s.reset.mode == drivers::FaultResetMode::Mode::level) ||
       s.role == drivers::SignalRole::window_start;
-  double v = self_clearing ? 0.0 : provider_.read_signal(e.device, s);
+  double v = self_clearing        ? 0.0
+             : e.element >= 0 ? provider_.read_element(e.device, s, static_cast<std::size_t>(e.element))
+                              : provider_.read_signal(e.device, s);
   double device_value = 0;
   if (!e.served.empty()) {
     // An enumerated signal: the code's own number, its `otherwise`, or a drive state's fallback

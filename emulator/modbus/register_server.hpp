@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <optional>
 #include <span>
@@ -43,6 +44,9 @@ class RegisterServer {
     bool stuck = false;
     std::optional<std::array<std::uint16_t, 2>> stuck_words;  // or the bit in [0]
     std::vector<std::optional<double>> served;  // an enumerated signal's device number per code (served_codes.hpp)
+    // An array signal is served as one entry per value, each on its own address (a copy of
+    // the signal in elements_ without a count): the value's index, or -1 for a single value.
+    int element = -1;
   };
   using Table = std::vector<Entry>;  // sorted by address
   using TableKey = std::pair<std::uint8_t, drivers::RegisterKind>;
@@ -63,6 +67,7 @@ class RegisterServer {
   std::vector<drivers::DeviceProfile> profiles_;
   SignalProvider& provider_;
   std::map<TableKey, Table> tables_;
+  std::deque<drivers::ProfileSignal> elements_;  // the array values' entries' signals (stable addresses)
 };
 
 }  // namespace synbench::emulator

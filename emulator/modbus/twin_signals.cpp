@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -52,10 +53,17 @@ TwinSignals::TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& 
     if (p.watchdog.kind != drivers::WatchdogKind::none) d.timeout_s = p.watchdog.timeout_ms / 1000.0;
     if (const drivers::ProfileSignal* r = p.find("fault_reset"))
       d.reset_on_edge = r->reset.mode == drivers::FaultResetMode::Mode::pulse;
-    for (const drivers::ProfileSignal& s : p.signals)
-      if (!value(p.kind, s))
+    for (const drivers::ProfileSignal& s : p.signals) {
+      if (s.count ? !array_values(p.kind, s) : !value(p.kind, s))
         throw std::invalid_argument(std::string(drivers::name(p.kind)) + " profile '" + p.name + "': signal " +
                                     s.name + ": the twin has no value for it");
+      // An array of batches holds the twin's batches, all of them.
+      if (s.count && s.count != twin.config().firmware.window_batches)
+        throw std::invalid_argument(std::string(drivers::name(p.kind)) + " profile '" + p.name + "': signal " +
+                                    s.name + ": count " + std::to_string(s.count) + ", but the twin keeps " +
+                                    std::to_string(twin.config().firmware.window_batches) +
+                                    " batches (firmware.window_batches)");
+    }
   }
 }
 
@@ -202,6 +210,25 @@ std::optional<double> TwinSignals::value(DeviceKind device, const drivers::Profi
   return std::nullopt;
 }
 
+std::optional<std::vector<double>> TwinSignals::array_values(DeviceKind device, const drivers::ProfileSignal& s) const {
+  const Served& w = fixed_ ? *fixed_ : windows_;
+  const auto of = [&](const auto& in, const auto& table) -> std::optional<std::vector<double>> {
+    if (const auto* f = drivers::find_array(table, s.name)) return drivers::numbers(in, f->member);
+    return std::nullopt;
+  };
+  switch (device) {
+    case DeviceKind::synrm_drive: return of(w.synrm_window, drivers::kSynrmWindowArrays);
+    case DeviceKind::load_drive: return of(w.load_window, drivers::kLoadWindowArrays);
+    case DeviceKind::vfc_meter: return of(w.meter_window, drivers::kMeterGateArrays);
+  }
+  return std::nullopt;
+}
+
+double TwinSignals::read_element(DeviceKind device, const drivers::ProfileSignal& s, std::size_t k) {
+  const auto v = array_values(device, s);
+  return v && k < v->size() ? (*v)[k] : std::numeric_limits<double>::quiet_NaN();
+}
+
 double TwinSignals::read_signal(DeviceKind device, const drivers::ProfileSignal& s) {
   return value(device, s).value_or(0.0);  // the constructor refused a profile with a signal it lacks
 }
@@ -233,6 +260,8 @@ void TwinSignals::close_window() {
         drivers::MeterReading& m = windows_.meter_window;
         m = twin_.meter_reading();
         // The meter turns counts into currents with its own calibration registers.
+        m.f0_Hz = f0_Hz_;
+        m.kf_Hz_per_A = kf_Hz_per_A_;
         const double g = m.gate_s;
         if (g > 0) {
           m.idcm_A = (static_cast<double>(m.counts_m) / g - f0_Hz_) / kf_Hz_per_A_;

@@ -33,6 +33,8 @@ class TwinSignals final : public SignalProvider {
   TwinSignals(Twin& twin, const std::vector<drivers::DeviceProfile>& profiles);
 
   double read_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s) override;
+  // A window's batches (NaN past the last batch, and for a window without batches).
+  double read_element(drivers::DeviceKind device, const drivers::ProfileSignal& s, std::size_t k) override;
   std::error_code write_signal(drivers::DeviceKind device, const drivers::ProfileSignal& s, double value) override;
   // With an any_write watchdog every accepted write restarts the device's timeout.
   void accepted_write(drivers::DeviceKind device) override;
@@ -73,6 +75,8 @@ class TwinSignals final : public SignalProvider {
   static const Control* find_control(drivers::DeviceKind device, std::string_view signal);
   // The engineering value of a signal, empty when the twin has none.
   std::optional<double> value(drivers::DeviceKind device, const drivers::ProfileSignal& s) const;
+  // The values of an array signal (the last window's batches), empty when the twin has none.
+  std::optional<std::vector<double>> array_values(drivers::DeviceKind device, const drivers::ProfileSignal& s) const;
   drivers::SynrmTelemetry synrm_telemetry() const;
   drivers::LoadTelemetry load_telemetry() const;
 

@@ -215,6 +215,10 @@ TEST(GeneratedDocs, RegisterMapShowsTheEncodings) {
                     "0 capwm, 1 aspwm |"),
             std::string::npos);
   EXPECT_NE(md.find("write every 100 ms; trips after 500 ms unchanged"), std::string::npos);
+  // An array signal: its whole span of addresses and its count.
+  EXPECT_NE(md.find("| `window_batch_im_A` | 1 | input | 144-163 | f32 x 10 | ABCD | 1 / 0 | A | r | -100 .. 100 | "
+                    "window_result | — |"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -162,6 +162,31 @@ const std::vector<InvalidCase> kInvalid = {
      [](json& d) { d["signals"]["heartbeat"].erase("period_ms"); }, "/signals/heartbeat/period_ms", "required"},
     {"period_on_another_signal", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["period_ms"] = 100; },
      "/signals/gate_s/period_ms", "heartbeat signal only"},
+    // Array signals ("count"): the catalogue's batch arrays need one, any other signal refuses it.
+    {"array_without_count", DeviceKind::vfc_meter, [](json& d) { d["signals"]["batch_counts_m"].erase("count"); },
+     "/signals/batch_counts_m/count", "required: batch_counts_m is an array of 2..64"},
+    {"count_on_a_single_value", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["count"] = 4; },
+     "/signals/gate_s/count", "gate_s is a single value; count applies to array signals only"},
+    {"count_below_two", DeviceKind::load_drive, [](json& d) { d["signals"]["window_batch_torque_Nm"]["count"] = 1; },
+     "/signals/window_batch_torque_Nm/count", "1 is outside 2..64"},
+    {"count_above_64", DeviceKind::synrm_drive, [](json& d) { d["signals"]["window_batch_im_A"]["count"] = 65; },
+     "/signals/window_batch_im_A/count", "65 is outside 2..64"},
+    {"count_not_an_integer", DeviceKind::synrm_drive, [](json& d) { d["signals"]["window_batch_im_A"]["count"] = "10"; },
+     "/signals/window_batch_im_A/count", "must be an integer"},
+    {"array_with_a_mask", DeviceKind::vfc_meter,
+     [](json& d) {
+       d["signals"]["batch_counts_m"]["type"] = "u16";
+       d["signals"]["batch_counts_m"]["max"] = 1;
+       d["signals"]["batch_counts_m"]["bit"] = 3;
+     },
+     "/signals/batch_counts_m/bit", "does not apply to an array"},
+    // The overlap check sees the whole array: u32 x 10 at 112 runs to 131.
+    {"overlap_with_an_arrays_last_value", DeviceKind::vfc_meter,
+     [](json& d) { d["signals"]["batch_counts_g"]["address"] = 131; }, "/signals/batch_counts_g/address",
+     "overlaps 'batch_counts_m' (input 112..131, unit id 3)"},
+    {"array_past_last_address", DeviceKind::vfc_meter,
+     [](json& d) { d["signals"]["batch_counts_g"]["address"] = 65530; }, "/signals/batch_counts_g/address",
+     "u32 x 10 at 65530 needs 20 registers and runs past 65535"},
 };
 
 class InvalidProfile : public testing::TestWithParam<InvalidCase> {};

@@ -4,7 +4,8 @@ exit 2 naming the flag, mbpoll (Debian's Modbus master) reading documented telem
 setpoint over TCP and RTU, and over both at once on one twin (a write on one link read back on the
 other, a cut silencing both), and `synbench point --bench` measuring one operating point over Modbus
 TCP and RTU (socat pseudo-terminals) with the same record as in-process, within the measurement
-noise. Exit 77 (skipped) where mbpoll or socat is missing."""
+noise, the emulator then serving that window's batches (10 per quantity, consistent with the
+window's means and counts). Exit 77 (skipped) where mbpoll or socat is missing."""
 import json
 import os
 import re
@@ -216,6 +217,27 @@ def same_record(name, rec):
     check(rec["truth"] is None, f"{name}: no truth from a Modbus bench")
 
 
+def served_batches(name, link, host):
+    """The last window's batches as `synbench emulate` serves them (docs/register-map.md): 10
+    f32 batch means per drive quantity averaging to the window's mean (mbpoll prints 6 digits),
+    10 u32 sub-gate counts per meter channel summing to the gate's counts exactly."""
+    def values(unit, table, address, count):
+        code, v = mbpoll(*link, "-a", str(unit), "-t", table, "-B", "-r", str(address), "-c", str(count), host)
+        return [float(v[k]) for k in sorted(v)] if code == 0 else []
+    for unit, mean_at, batches_at, what in ((1, 110, 144, "window_im_A"), (1, 108, 164, "window_speed_meas_rpm"),
+                                            (2, 104, 106, "window_torque_Nm")):
+        mean, batches = values(unit, "3:float", mean_at, 1), values(unit, "3:float", batches_at, 10)
+        ok = len(mean) == 1 and len(batches) == 10 and mean[0] != 0
+        # Speed: a batch's encoder count is 0.03 rpm of the mean over 10 batches at 1 s.
+        tol = 2e-5 * abs(mean[0]) + (0.1 if what == "window_speed_meas_rpm" else 0)
+        check(ok and abs(sum(batches) / 10 - mean[0]) <= tol,
+              f"{name}: emulate serves 10 batches of {what} averaging to its window mean: {mean} vs {batches}")
+    for total_at, batches_at, what in ((102, 112, "counts_m"), (104, 132, "counts_g")):
+        total, batches = values(3, "3:int", total_at, 1), values(3, "3:int", batches_at, 10)
+        check(len(total) == 1 and len(batches) == 10 and total[0] > 0 and sum(batches) == total[0],
+              f"{name}: emulate serves 10 sub-gate {what} summing to the gate's: {total} vs {batches}")
+
+
 emu = Emulator("--tcp", "127.0.0.1:0", *SCALED)
 # The bench config's "uncertainty" reaches the point's budget over Modbus (docs/uncertainty.md).
 cfg = bench_config("tcp", {"transport": "tcp", "host": "127.0.0.1", "port": emu.port, "response_timeout_ms": 200},
@@ -227,9 +249,12 @@ check(code == 0, f"point over TCP ({wall:.2f} s wall): {err.strip()[:200]}")
 if code == 0:
     rec, budget = json.loads(out)["record"], json.loads(out)["budget"]
     same_record("tcp", rec)
+    served_batches("tcp", ["-m", "tcp", "-p", str(emu.port)], "127.0.0.1")
     comps = {c["name"]: c for c in budget["components"]}
     check(abs(comps["U_dc gain"]["u"] - 0.02 * rec["udc_V"]) < 1e-6 and comps["torque offset"]["u"] == 0.05,
           f"tcp: the bench config's uncertainty section in the budget ({comps['U_dc gain']['u']} V)")
+    check(rec["pdcm_u_W"] is not None and rec["pdcm_u_repeat_W"] is not None and rec["efficiency_u"] is not None,
+          f"tcp: the served batches give every uncertainty (pdcm_u_repeat_W {rec['pdcm_u_repeat_W']})")
     check(rec["pdcm_u_W"] == budget["combined"]["pdcm_W"] and rec["pm_u_W"] == budget["combined"]["pm_W"]
           and rec["efficiency_u_repeat"] == budget["repeat"]["efficiency"],
           f"tcp: the record's u fields are its budget's (pdcm_u_W {rec['pdcm_u_W']})")
@@ -245,6 +270,7 @@ wall = time.time() - t0
 check(code == 0, f"point over RTU ({wall:.2f} s wall): {err.strip()[:200]}")
 if code == 0:
     same_record("rtu", json.loads(out))
+    served_batches("rtu", ["-m", "rtu", "-b", "115200", "-P", "none"], pair.b)
 code, emu_out, _ = emu.stop()
 print("  " + " | ".join(emu_out.strip().splitlines()[-2:]))
 pair.stop()

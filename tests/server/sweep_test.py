@@ -72,6 +72,17 @@ pts = json.load(open(json_path))
 check(len(pts) == 16 and all(abs(p["speed_meas_rpm"] - p["speed_rpm"]) < 1 for p in pts), "JSON export of the records")
 an = json.load(open(an_path))
 check(len(an["curves"]["entries"]) == 4, "analysis: one MTPA/ME curve per (speed, load)")
+# The optima's uncertainties follow the records' (docs/analysis.md, "Uncertainty"): known where
+# every point of the curve has its repeat u, null (never invented) where none has.
+u_ok = an["uncertainty"]["me_minus_mtpa"]["curves"] == 4
+for c in an["curves"]["entries"]:
+    mine = [p for p in pts if p["speed_rpm"] == c["speed_rpm"] and p["load_Nm"] == c["load_Nm"]]
+    have = [p.get("pdcm_u_repeat_W") is not None for p in mine]
+    got = c["me"]["pdcm_u_repeat_W"]
+    u_ok = u_ok and (got is not None if all(have) else True) and (got is None if not any(have) else True)
+    u_ok = u_ok and all(k in c for k in ("mtpa_angle_u_deg", "me_angle_u_deg", "me_minus_mtpa_u_deg",
+                                         "me_minus_mtpa_significant"))
+check(u_ok, "analysis: the optima's uncertainties known exactly where the records carry theirs")
 
 # --- crash safety: kill -9 at random moments, then resume
 # Longer windows for more kills, so the sweep outlasts them (100 kills: the benchmark run).

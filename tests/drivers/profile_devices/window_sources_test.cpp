@@ -207,7 +207,13 @@ TEST(ProfileBenchHostWindows, TheClockSamplesWhileTheBenchWaits) {
   EXPECT_EQ(lw.keeper, WindowKeeper::host);
   EXPECT_EQ(lw.samples, 11u);
   EXPECT_NEAR(lw.torque_Nm, 2.0, 1e-6);
+  // 11 polls are too few for 10 batches of at least 2 polls on average: none.
+  EXPECT_TRUE(w.batch_im_A.empty());
+  EXPECT_TRUE(lw.batch_torque_Nm.empty());
   EXPECT_EQ(m.keeper, WindowKeeper::device);
+  EXPECT_EQ(m.f0_Hz, mp.f0_Hz);  // the totalizer's currents come from the profile's calibration
+  EXPECT_EQ(m.kf_Hz_per_A, mp.kf_Hz_per_A);
+  EXPECT_TRUE(m.batch_counts_m.empty());
   EXPECT_GT(bench.meter().totalizer()->wraps(), 0);
   EXPECT_NEAR(m.gate_s, 0.5, 1e-5);
   EXPECT_NEAR(m.idcm_A, 2.0, 1e-3);
@@ -254,6 +260,69 @@ TEST(ProfileBenchHostWindows, AMasterFrozenPastTheEndLeavesAGapAndTheDevicesCode
   EXPECT_NEAR(w.host.longest_gap_s, 20.0, 0.01);
   EXPECT_NEAR(w.window_s, 20.3, 1e-6);
   EXPECT_NEAR(m.gate_s, 20.3, 1e-5);
+}
+
+// A host-kept window splits its polls into kHostWindowBatches equal spans of time: the means
+// of the ramp over each tenth of the window, the close's sample with the last.
+TEST_F(HostFixture, SplitsItsPollsIntoBatchesByTime) {
+  ManualClock clock;
+  bus.before = [&](const FakeBus::Request&) { bus.set(*profile.find("speed_rpm"), 100 + 10 * clock.t); };
+  ASSERT_FALSE(window.open(0.0, 1.0));
+  bool done = false;
+  for (int i = 0; i <= 100 && !done; ++i) {
+    clock.t = i * 0.01;
+    ASSERT_FALSE(window.poll(clock.t, done));
+  }
+  ASSERT_EQ(window.samples(), 21u);
+  const std::vector<double> b = window.batch_means(0);
+  ASSERT_EQ(b.size(), kHostWindowBatches);
+  // Batch k holds the polls at 0.1 k and 0.1 k + 0.05 s; the last also the close at 1 s.
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) EXPECT_NEAR(b[k], 100.25 + static_cast<double>(k), 1e-3) << k;
+  EXPECT_NEAR(b.back(), 109.5, 1e-3);
+  EXPECT_TRUE(window.batch_means(2).size() == kHostWindowBatches && std::isnan(window.batch_means(2)[0]));
+}
+
+TEST_F(HostFixture, FewerThanTwoPollsPerBatchKeepNoBatches) {
+  HostWindow slow{io, plan, 0.1};  // 11 polls over 1 s
+  ManualClock clock;
+  ASSERT_FALSE(slow.open(0.0, 1.0));
+  bool done = false;
+  for (int i = 0; i <= 100 && !done; ++i) {
+    clock.t = i * 0.01;
+    ASSERT_FALSE(slow.poll(clock.t, done));
+  }
+  ASSERT_EQ(slow.samples(), 11u);
+  EXPECT_TRUE(slow.batch_means(0).empty());
+}
+
+// Through the typed devices: a load step 0.35 s into a host-kept window shows in batch 3 (half
+// its polls after the step) and in every batch after it.
+TEST(ProfileBenchHostWindows, ALoadStepShowsInTheHostWindowsBatches) {
+  FakeBus bus;
+  ManualClock clock;
+  ProfileBench bench{bus, test_profile("synrm_host_window.json"), bus, test_profile("load_host_window.json"),
+                     bus, test_profile("meter_totalizer.json"), clock};
+  const DeviceProfile& sp = bench.synrm().profile();
+  bus.set(*sp.find("udc_V"), 425);
+  bus.before = [&](const FakeBus::Request&) {
+    bus.set(*bench.load().profile().find("torque_Nm"), clock.t < 0.35 - 1e-9 ? 1.0 : 2.0);
+    bus.set(*sp.find("speed_rpm"), 600 + 20 * clock.t);
+  };
+  ASSERT_FALSE(bench.trigger().open_window(1.0));
+  while (!bench.trigger().window_closed()) bench.clock().wait_until(clock.t + 0.01);
+  LoadWindow lw;
+  SynrmWindow w;
+  ASSERT_FALSE(bench.load().read_window(lw));
+  ASSERT_FALSE(bench.synrm().read_window(w));
+  ASSERT_EQ(lw.samples, 21u);
+  const auto& t = lw.batch_torque_Nm;
+  ASSERT_EQ(t.size(), 10u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(t[k], 1.0, 1e-6) << k;
+  EXPECT_NEAR(t[3], 1.5, 1e-6);
+  for (std::size_t k = 4; k < 10; ++k) EXPECT_NEAR(t[k], 2.0, 1e-6) << k;
+  ASSERT_EQ(w.batch_speed_meas_rpm.size(), 10u);
+  EXPECT_NEAR(w.batch_speed_meas_rpm[0], 600.5, 1e-3);  // polls at 0 and 0.05 s
+  EXPECT_EQ(w.batch_im_A.size(), 10u);
 }
 
 }  // namespace

@@ -93,7 +93,9 @@ TEST_F(Server, BitsArePackedLowFirst) {
 }
 
 TEST_F(Server, AddressesBeyondTheMapAreIllegal) {
-  EXPECT_EQ(ask(1, read_req(kReadInputRegisters, 142, 2)), (std::vector<std::uint8_t>{0x84, kIllegalDataAddress}));
+  // The SynRM drive's last input register is 183 (window_batch_speed_meas_rpm's last value).
+  EXPECT_EQ(ask(1, read_req(kReadInputRegisters, 182, 2)).size(), 6u);
+  EXPECT_EQ(ask(1, read_req(kReadInputRegisters, 183, 2)), (std::vector<std::uint8_t>{0x84, kIllegalDataAddress}));
   EXPECT_EQ(ask(3, read_req(kReadCoils, 0, 5)), (std::vector<std::uint8_t>{0x81, kIllegalDataAddress}));
   EXPECT_EQ(ask(1, read_req(kReadInputRegisters, 0, 126)), (std::vector<std::uint8_t>{0x84, kIllegalDataValue}));
   EXPECT_EQ(ask(1, {0x2B, 0x0E}), (std::vector<std::uint8_t>{0xAB, kIllegalFunction}));

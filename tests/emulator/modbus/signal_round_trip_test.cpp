@@ -60,6 +60,27 @@ void expect_same(const S& sent, const S& read, const drivers::SignalField<S> (&t
   }
 }
 
+// `read` has every array of `table` as `sent` has it (each value within what its register
+// carries); an empty array reads empty (registers of zeros: no batches).
+template <class S, std::size_t N>
+void expect_same_arrays(const S& sent, const S& read, const drivers::ArrayField<S> (&table)[N],
+                        const drivers::DeviceProfile& profile) {
+  for (const auto& f : table) {
+    const std::vector<double> a = drivers::numbers(sent, f.member), b = drivers::numbers(read, f.member);
+    ASSERT_EQ(b.size(), a.size()) << f.signal;
+    const drivers::ProfileSignal* s = profile.find(f.signal);
+    ASSERT_NE(s, nullptr) << f.signal;
+    for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(b[k], a[k], tolerance(*s, a[k])) << f.signal << "[" << k << "]";
+  }
+}
+
+// B distinct values around `base` (B = the twin's firmware.window_batches).
+std::vector<double> batches(double base) {
+  std::vector<double> v;
+  for (int k = 0; k < TwinConfig{}.firmware.window_batches; ++k) v.push_back(base + 0.125 * (k + 1));
+  return v;
+}
+
 struct RoundTrip : ::testing::Test {
   std::vector<drivers::DeviceProfile> profiles = default_profiles();
   TwinService service{TwinConfig{}, profiles};
@@ -117,6 +138,8 @@ struct RoundTrip : ::testing::Test {
     w.ld_est_H = 0.0123;
     w.lq_est_H = 0.0456;
     w.rs_est_ohm = 0.789;
+    w.batch_im_A = batches(5.0);
+    w.batch_speed_meas_rpm = batches(980.0);
     return w;
   }
   static TwinSignals::Served served() {
@@ -129,11 +152,14 @@ struct RoundTrip : ::testing::Test {
     s.load.iq_A = 8.5;
     s.load_window.samples = 777;
     s.load_window.torque_Nm = 2.125;
+    s.load_window.batch_torque_Nm = batches(1.5);
     s.meter_window.counts_m = 123456;
     s.meter_window.counts_g = 98765;
     s.meter_window.gate_s = 0.5;
     s.meter_window.idcm_A = 3.25;
     s.meter_window.idcg_A = -1.75;
+    for (const double c : batches(12345)) s.meter_window.batch_counts_m.push_back(static_cast<std::uint64_t>(8 * c));
+    for (const double c : batches(9876)) s.meter_window.batch_counts_g.push_back(static_cast<std::uint64_t>(8 * c));
     return s;
   }
 };
@@ -166,6 +192,8 @@ TEST_F(RoundTrip, SynrmWindowWithItsEstimates) {
   drivers::SynrmWindow w;
   ASSERT_FALSE(bench.synrm().read_window(w));
   expect_same(s.synrm_window, w, drivers::kSynrmWindowSignals, profiles[0]);
+  EXPECT_EQ(w.batch_im_A.size(), 10u);
+  expect_same_arrays(s.synrm_window, w, drivers::kSynrmWindowArrays, profiles[0]);
   EXPECT_EQ(w.keeper, drivers::WindowKeeper::device);
 
   // A window without an Ld estimate says so (window_estimates_present): empty, not 0 H.
@@ -188,6 +216,32 @@ TEST_F(RoundTrip, LoadTelemetryAndWindow) {
   drivers::LoadWindow w;
   ASSERT_FALSE(bench.load().read_window(w));
   expect_same(s.load_window, w, drivers::kLoadWindowSignals, profiles[1]);
+  EXPECT_EQ(w.batch_torque_Nm.size(), 10u);
+  expect_same_arrays(s.load_window, w, drivers::kLoadWindowArrays, profiles[1]);
+}
+
+// A window the device kept no batches of serves registers of zeros: the bench reads none.
+TEST_F(RoundTrip, AWindowWithoutBatchesReadsNone) {
+  TwinSignals::Served s = served();
+  s.synrm_window.batch_im_A.clear();
+  s.synrm_window.batch_speed_meas_rpm.clear();
+  s.load_window.batch_torque_Nm.clear();
+  s.meter_window.batch_counts_m.clear();
+  s.meter_window.batch_counts_g.clear();
+  run_window();
+  serve(s);
+  drivers::SynrmWindow w;
+  ASSERT_FALSE(bench.synrm().read_window(w));
+  EXPECT_TRUE(w.batch_im_A.empty());
+  EXPECT_TRUE(w.batch_speed_meas_rpm.empty());
+  EXPECT_EQ(w.im_A, 5.5);
+  drivers::LoadWindow l;
+  ASSERT_FALSE(bench.load().read_window(l));
+  EXPECT_TRUE(l.batch_torque_Nm.empty());
+  drivers::MeterReading m;
+  ASSERT_FALSE(bench.meter().read(m));
+  EXPECT_TRUE(m.batch_counts_m.empty());
+  EXPECT_TRUE(m.batch_counts_g.empty());
 }
 
 TEST_F(RoundTrip, MeterGate) {
@@ -198,6 +252,11 @@ TEST_F(RoundTrip, MeterGate) {
   drivers::MeterReading m;
   ASSERT_FALSE(bench.meter().read(m));
   expect_same(s.meter_window, m, drivers::kMeterGateSignals, profiles[2]);
+  EXPECT_EQ(m.batch_counts_m.size(), 10u);
+  expect_same_arrays(s.meter_window, m, drivers::kMeterGateArrays, profiles[2]);
+  // The calibration the meter's registers hold comes with the reading.
+  EXPECT_EQ(m.f0_Hz, TwinConfig{}.vfc.f0_Hz);
+  EXPECT_EQ(m.kf_Hz_per_A, TwinConfig{}.vfc.kf_Hz_per_A);
 }
 
 // The twin's own values reach the bench too: with the fixed structs withdrawn, the registers
@@ -245,7 +304,9 @@ TEST(TwinSignalNames, TheTwinServesEveryCatalogueSignal) {
       s.name = std::string(spec.name);
       s.role = spec.role;
       s.kind = drivers::RegisterKind::input;
-      s.address = address++;
+      s.address = address;
+      if (spec.array) s.count = static_cast<std::uint8_t>(TwinConfig{}.firmware.window_batches);
+      address = static_cast<std::uint16_t>(s.last_address() + 1);
       p.signals.push_back(s);
     }
     Twin twin{TwinConfig{}};
