@@ -82,7 +82,12 @@ try {
     check(feedRows.every((r) => byIndex.has(r.index) && Math.abs(Number(r.eta) - byIndex.get(r.index).efficiency) < 1e-9),
       `each feed row's η is its stored point's efficiency (${feedRows.map((r) => r.eta).join(', ')})`);
     check(feedRows[0].index > feedRows[1].index, 'the newest point is first');
-    check(/η 0\.\d+, I_m [\d.]+ A, P_dcM [\d.]+ W, settle [\d.]+ s, (settled|unstable)/.test(feedRows[0].text), `a row reads "${feedRows[0].text}"`);
+    check(/η 0\.\d+ ± [\d.]+, I_m [\d.]+ ± [\d.]+ A, P_dcM [\d.]+ ± [\d.]+ W, settle [\d.]+ s, (settled|unstable)/.test(feedRows[0].text), `a row reads "${feedRows[0].text}"`);
+    // Each value's ± is its stored point's combined standard uncertainty (issue 26), in the order η, I_m, P_dcM.
+    const us = await page.$$eval('#live-points li', (ls) => ls.map((l) => ({ index: Number(l.dataset.index), u: [...l.querySelectorAll('.u')].map((e) => Number(e.dataset.u)) })));
+    check(us.length >= 2 && us.every((r) => { const p = byIndex.get(r.index); return p && r.u.length === 3 && p.efficiency_u > 0
+      && r.u[0] === p.efficiency_u && r.u[1] === p.im_u_A && r.u[2] === p.pdcm_u_W; }),
+      `each feed row's ± u are its stored point's efficiency_u, im_u_A, pdcm_u_W (${JSON.stringify(us[0]?.u)})`);
   }
   await shot(page, artifacts, 'live-1-sweep');
 

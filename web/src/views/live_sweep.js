@@ -1,8 +1,10 @@
 // The Live view while a sweep owns the bench: the readout's sweep line ("sweep #2 running,
 // point 85/665") and the point's configuration, the manual controls disabled with the reason in
-// their title, and the feed of the last ~10 measured points (newest first: η, I_m, P_dcM, settle
-// time, gate), read from the sweep's stored points when its count of stored points changes.
+// their title, and the feed of the last ~10 measured points (newest first: η, I_m, P_dcM with
+// their standard uncertainty where the point has one, settle time, gate), read from the sweep's
+// stored points when its count of stored points changes.
 import { api } from '../api.js';
+import { fmtU, known } from '../errorbars.js';
 import { sig } from '../scope.js';
 
 const ACTIVE = ['running', 'pausing', 'paused', 'stopping'];
@@ -23,6 +25,16 @@ export function sweepRows(st) {
   const p = sw.point;
   if (p) rows.push(['point', `${sig(p.speed_rpm)} rpm, ${sig(p.load_Nm)} N m, ${sig(p.angle_deg)}°, ${p.estimator}/${p.pwm}`]);
   return rows;
+}
+
+// "0.7043 ± 0.0085" with the combined u (k = 1) and, in the title, its point-to-point part (what a
+// comparison with the curve's neighbours carries, docs/uncertainty.md); the bare value without u.
+function withU(value, digits, u, uRepeat, unit) {
+  if (value == null) return '–';
+  if (!known(u)) return `${sig(value, digits)}${unit}`;
+  const title = `standard uncertainty (k = 1): ${fmtU(u)}${unit}`
+    + (known(uRepeat) ? `, point to point ${fmtU(uRepeat)}${unit}` : '');
+  return `<span class="u" title="${title}" data-u="${u}">${sig(value, digits)} ± ${fmtU(u)}${unit}</span>`;
 }
 
 export class SweepFeed {
@@ -68,7 +80,8 @@ export class SweepFeed {
       const gate = p.fault ? `fault ${p.fault}` : p.unstable ? 'unstable' : 'settled';
       return `<li data-eta="${p.efficiency ?? ''}" data-index="${p.point_index}"><b>#${p.point_index + 1}</b> `
         + `${sig(p.speed_rpm)} rpm ${sig(p.load_Nm)} N m ${sig(p.angle_deg)}°: `
-        + `η ${p.efficiency == null ? '–' : sig(p.efficiency, 3)}, I_m ${sig(p.im_A, 3)} A, P_dcM ${sig(p.pdcm_W, 3)} W, `
+        + `η ${withU(p.efficiency, 3, p.efficiency_u, p.efficiency_u_repeat, '')}, `
+        + `I_m ${withU(p.im_A, 3, p.im_u_A, p.im_u_repeat_A, ' A')}, P_dcM ${withU(p.pdcm_W, 4, p.pdcm_u_W, p.pdcm_u_repeat_W, ' W')}, `
         + `settle ${sig(p.settle_s, 3)} s, <span class="gate ${p.unstable || p.fault ? 'bad' : 'ok'}">${gate}</span></li>`;
     }).join('');
   }
