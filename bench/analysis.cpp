@@ -128,6 +128,7 @@ Analysis analyze(const std::vector<PointRecord>& records, const AnalysisOptions&
     if (options.exclude_voltage_limited && r.voltage_limited) reasons.push_back("voltage_limited");
     if (options.exclude_below_min_speed && r.below_min_speed) reasons.push_back("below_min_speed");
     if (options.exclude_lock_lost && r.lock_lost) reasons.push_back("lock_lost");
+    if (options.exclude_angle_off && r.angle_off) reasons.push_back("angle_off");
     if (reasons.empty()) {
       used.push_back(i);
     } else {

@@ -29,6 +29,9 @@ struct AnalysisOptions {
   bool exclude_below_min_speed = true;
   // Run on the encoder after the drive's lock guard took over: not the estimator either.
   bool exclude_lock_lost = true;
+  // The drive ran at another current angle than the one the point is filed under (angle_off):
+  // its I_m and P_dcM belong to a different place on the curve and would bend the fitted optima.
+  bool exclude_angle_off = true;
   // Histogram bin widths of the thesis (Figs. 6.16 to 6.19).
   double pos_err_bin_deg = 0.5;
   double ld_err_bin_pct = 5.0;

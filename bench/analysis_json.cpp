@@ -159,6 +159,7 @@ ojson to_json(const Analysis& a) {
   opt["exclude_voltage_limited"] = o.exclude_voltage_limited;
   opt["exclude_below_min_speed"] = o.exclude_below_min_speed;
   opt["exclude_lock_lost"] = o.exclude_lock_lost;
+  opt["exclude_angle_off"] = o.exclude_angle_off;
   opt["bin_width"] = {{"pos_err_mean_deg", o.pos_err_bin_deg},
                       {"ld_err_pct", o.ld_err_bin_pct},
                       {"lq_err_pct", o.lq_err_bin_pct},

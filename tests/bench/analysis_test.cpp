@@ -289,6 +289,28 @@ TEST(Analysis, FlaggedPointsAreExcludedAndReported) {
   EXPECT_LT(c->mtpa.im_A, 1.0);
 }
 
+TEST(Analysis, APointRunAtAnotherAngleIsLeftOut) {
+  auto recs = campaign();
+  // The drive ran far from the 52 deg it was asked for, and the point looks like the curve's best.
+  PointRecord off = recs[6];
+  off.angle_off = true;
+  off.angle_meas_deg = 40.0;
+  off.im_A = 0.5;
+  off.pdcm_W = 50;
+  recs.push_back(off);
+
+  const auto a = analyze(recs);
+  ASSERT_EQ(a.excluded.size(), 1u);
+  EXPECT_EQ(a.excluded[0].reasons, std::vector<std::string>{"angle_off"});
+  EXPECT_NEAR(find_curve(a, kReferenceConfiguration, 500, 1)->mtpa.angle_deg, 50.0, 1e-9);
+
+  AnalysisOptions keep;
+  keep.exclude_angle_off = false;
+  const auto b = analyze(recs, keep);
+  EXPECT_TRUE(b.excluded.empty());
+  EXPECT_LT(find_curve(b, kReferenceConfiguration, 500, 1)->mtpa.im_A, 1.0);
+}
+
 TEST(Analysis, EdgeOptimaAreFlaggedAndNotRefined) {
   std::vector<PointRecord> recs;
   add_curve(recs, {kReferenceConfiguration, 300, 3, 35.0, 2.0, 80.0, 300, 94.0});
