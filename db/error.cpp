@@ -24,6 +24,10 @@ class Category final : public std::error_category {
       case errc::file_lost: return "the database file was deleted or replaced while open";
       case errc::disk_full: return "disk full";
       case errc::read_only: return "the database cannot be written (read-only)";
+      case errc::duplicate_key: return "a sweep with that key is already stored";
+      case errc::postgres: return "PostgreSQL error";
+      case errc::connection_lost: return "connection to the PostgreSQL server lost";
+      case errc::unsupported: return "not supported by this database backend";
     }
     return "unknown database error";
   }
@@ -46,7 +50,9 @@ bool is_storage_failure(std::error_code ec) noexcept {
     case errc::bad_record:
     case errc::file_lost:
     case errc::disk_full:
-    case errc::read_only: return true;
+    case errc::read_only:
+    case errc::postgres:
+    case errc::connection_lost: return true;
     default: return false;
   }
 }

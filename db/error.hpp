@@ -29,6 +29,10 @@ enum class errc {
   file_lost,           // the open file was deleted or replaced at its path: writes would vanish
   disk_full,           // SQLITE_FULL: no space left (or the connection's max_page_count)
   read_only,           // the file, its directory or its file system cannot be written
+  duplicate_key,       // a sweep with that key is already stored; nothing was changed
+  postgres,            // PostgreSQL reported a failure not classified here (message: text, SQLSTATE)
+  connection_lost,     // the PostgreSQL server cannot be reached or closed the connection
+  unsupported,         // a SQLite-only feature asked of PostgreSQL (pragma, max_page_count)
 };
 
 // Whether a failure is the database's (the file, the disk, SQLite) rather than the caller's

@@ -1,6 +1,8 @@
-// The database schema as an ordered list of migrations, tracked by PRAGMA user_version.
-// Step N takes a database from version N-1 to N in one transaction. Steps are history: once
-// released, a step's SQL never changes; a schema change is a new step at the end.
+// The database schema as an ordered list of migrations, tracked by PRAGMA user_version on
+// SQLite and by the synbench_schema table on PostgreSQL. Step N takes a database from version
+// N-1 to N in one transaction. Each step carries both dialects side by side, so a step cannot
+// be added for one backend only. Steps are history: once released, a step's SQL never changes;
+// a schema change is a new step at the end.
 #pragma once
 
 #include <cstdint>
@@ -16,7 +18,8 @@ namespace synbench::db {
 struct Migration {
   int version;                   // user_version after this step: 1, 2, 3, ...
   std::string_view description;  // one line, for people reading the code and the docs
-  std::string_view sql;          // one or more statements, run inside the step's transaction
+  std::string_view sql;          // SQLite: one or more statements, run inside the step's transaction
+  std::string_view pg_sql;       // PostgreSQL: the same step in its dialect
 };
 
 // synbench's migrations, in order.

@@ -5,6 +5,7 @@
 #include <ctime>
 #include <stdexcept>
 
+#include "db/bench_identity.hpp"
 #include "db/file_watch.hpp"
 #include "db/migrations.hpp"
 #include "db/owner.hpp"
@@ -70,7 +71,8 @@ std::string select_points_sql() {
 constexpr std::string_view kSweepColumns =
     "SELECT s.id, s.name, s.created_at, s.started_at, s.finished_at, s.state, s.plan_json, "
     "s.software_version, s.profiles_json, s.bench_config_json, s.calibration_json, "
-    "s.total_points, s.last_error, (SELECT count(*) FROM points p WHERE p.sweep_id = s.id) "
+    "s.total_points, s.last_error, (SELECT count(*) FROM points p WHERE p.sweep_id = s.id), "
+    "s.bench_name, s.bench_host, s.devices_json, s.key "
     "FROM sweeps s";
 
 }  // namespace
@@ -81,17 +83,19 @@ struct Store::Impl {
   detail::FileWatch watch;
   detail::ProcessOwner me = detail::this_process();
   std::function<void(const Error&)> on_error;
+  BenchIdentity bench;
   detail::TransactionStatements tx;
   Statement insert_sweep, insert_event, sweep_for_update, update_sweep_state, select_sweep,
       select_sweeps, sweep_total, sweep_exists, insert_point, select_points, select_indices,
-      select_events_of_sweep, select_events_all, select_running;
+      select_events_of_sweep, select_events_all, select_running, select_sweep_by_key;
 
   ~Impl() {
     // Statements first: sqlite3_close_v2 would otherwise defer the close until they are gone.
     tx = {};
     for (auto* s : {&insert_sweep, &insert_event, &sweep_for_update, &update_sweep_state, &select_sweep,
                     &select_sweeps, &sweep_total, &sweep_exists, &insert_point, &select_points,
-                    &select_indices, &select_events_of_sweep, &select_events_all, &select_running})
+                    &select_indices, &select_events_of_sweep, &select_events_all, &select_running,
+                    &select_sweep_by_key})
       *s = Statement();
     sqlite3_close_v2(db);
   }
@@ -130,7 +134,8 @@ struct Store::Impl {
     const std::pair<Statement*, std::string> all[] = {
         {&insert_sweep,
          "INSERT INTO sweeps (name, created_at, state, plan_json, software_version, profiles_json, "
-         "bench_config_json, calibration_json, total_points) VALUES (?, ?, 'created', ?, ?, ?, ?, ?, ?)"},
+         "bench_config_json, calibration_json, total_points, bench_name, bench_host, devices_json, key) "
+         "VALUES (?, ?, 'created', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"},
         {&insert_event, "INSERT INTO events (sweep_id, at, kind, message) VALUES (?, ?, ?, ?)"},
         {&sweep_for_update,
          "SELECT state, started_at, total_points, (SELECT count(*) FROM points WHERE sweep_id = ?1) "
@@ -140,6 +145,7 @@ struct Store::Impl {
          "last_error = coalesce(?, last_error), owner_host = ?, owner_pid = ?, owner_start = ? WHERE id = ?"},
         {&select_sweep, std::string(kSweepColumns) + " WHERE s.id = ?"},
         {&select_sweeps, std::string(kSweepColumns) + " ORDER BY s.id"},
+        {&select_sweep_by_key, std::string(kSweepColumns) + " WHERE s.key = ?"},
         {&sweep_total, "SELECT total_points FROM sweeps WHERE id = ?"},
         {&sweep_exists, "SELECT 1 FROM sweeps WHERE id = ?"},
         {&insert_point, insert_point_sql()},
@@ -194,6 +200,14 @@ struct Store::Impl {
     s.meta.total_points = st.integer(11);
     s.last_error = st.opt_text(12);
     s.points_stored = st.integer(13);
+    s.meta.bench_name = st.opt_text(14).value_or("");
+    s.meta.bench_host = st.opt_text(15).value_or("");
+    if (const auto devices = st.opt_text(16)) {
+      auto d = parse_devices_json(*devices);
+      if (!d) return make_error(errc::bad_record, "sweep " + std::to_string(s.id) + ": " + d.error().message);
+      s.meta.devices = std::move(*d);
+    }
+    s.meta.key = st.opt_text(17);
     return s;
   }
 
@@ -364,6 +378,7 @@ Result<Store> Store::open(const std::filesystem::path& path, const StoreOptions&
   if (!watch) return Error{watch.error().code, where + ": " + watch.error().message};
   impl->watch = std::move(*watch);
   impl->on_error = options.on_error;
+  impl->bench = resolved(options.bench);
   return Store(std::move(impl));
 }
 
@@ -385,7 +400,13 @@ Result<std::int64_t> Store::create_sweep(const SweepMeta& meta) {
     st.bind(6, json_text(meta.bench_config));
     st.bind(7, json_text(meta.calibration));
     st.bind(8, meta.total_points);
+    st.bind(9, meta.bench_name.empty() ? d.bench.name : meta.bench_name);
+    st.bind(10, meta.bench_host.empty() ? d.bench.host : meta.bench_host);
+    st.bind(11, devices_json(meta.devices.empty() ? d.bench.devices : meta.devices));
+    st.bind(12, meta.key);
     const int rc = st.step();
+    if (meta.key && (rc == SQLITE_CONSTRAINT_UNIQUE || rc == SQLITE_CONSTRAINT_PRIMARYKEY))
+      return make_error(errc::duplicate_key, "a sweep with key \"" + *meta.key + "\" is already stored");
     if (rc != SQLITE_DONE) return d.fail(rc, "creating a sweep");
     id = sqlite3_last_insert_rowid(d.db);
   }
@@ -464,6 +485,20 @@ Result<Sweep> Store::get_sweep(std::int64_t sweep_id) {
   if (rc == SQLITE_DONE) return make_error(errc::not_found, "no sweep " + std::to_string(sweep_id));
   if (rc != SQLITE_ROW) return d.fail(rc, "reading a sweep");
   return d.read_sweep(st);
+}
+
+Result<std::optional<Sweep>> Store::find_sweep_by_key(std::string_view key) {
+  auto& d = impl();
+  if (auto s = d.check_file(); !s) return s.error();
+  auto& st = d.select_sweep_by_key;
+  Statement::Use use(st);
+  st.bind(1, key);
+  const int rc = st.step();
+  if (rc == SQLITE_DONE) return std::optional<Sweep>();
+  if (rc != SQLITE_ROW) return d.fail(rc, "finding a sweep by key");
+  auto s = d.read_sweep(st);
+  if (!s) return s.error();
+  return std::optional<Sweep>(std::move(*s));
 }
 
 Result<std::vector<Sweep>> Store::list_sweeps() {

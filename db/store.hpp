@@ -49,6 +49,10 @@ struct StoreOptions {
   // Told of every failure of the storage itself (is_storage_failure: SQLite, the file, the disk),
   // with the message the caller gets; not of refusals such as an unknown sweep. For the log.
   std::function<void(const Error&)> on_error;
+  // The bench this process writes as: stamped on every sweep created without its own identity
+  // (an empty SweepMeta::bench_name, bench_host or devices). Empty name and host default to
+  // this machine's host name.
+  BenchIdentity bench;
 };
 
 class Store {
@@ -69,8 +73,12 @@ class Store {
   const std::filesystem::path& path() const;
 
   // --- sweeps ---
-  // A new sweep in state `created` (and its `state` event), in one transaction.
+  // A new sweep in state `created` (and its `state` event), in one transaction. An empty bench
+  // identity in `meta` is the store's (StoreOptions::bench). errc::duplicate_key if meta.key is
+  // set and another sweep has it (nothing changes).
   Result<std::int64_t> create_sweep(const SweepMeta& meta);
+  // The sweep created with this key, or nullopt.
+  Result<std::optional<Sweep>> find_sweep_by_key(std::string_view key);
   // Changes the state, records a `state` event ("running -> paused: <error>") in the same
   // transaction, stamps started_at (first time running) and finished_at (completed, aborted,
   // faulted; cleared when resumed), and keeps `error` as last_error if given. Refuses

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "bench/point_record.hpp"
 #include "synbench/version.hpp"
@@ -21,6 +22,18 @@ enum class SweepState { created, running, paused, completed, aborted, faulted };
 std::string_view name(SweepState s) noexcept;
 std::optional<SweepState> parse_sweep_state(std::string_view s) noexcept;
 
+// One device of the bench as a sweep saw it: its role, its profile's name and the profile's
+// version. Profiles carry no version number of their own, so the version is the profile's
+// content digest ("fnv1a64:<16 hex digits>" of its canonical JSON, db/bench_identity.hpp): two
+// sweeps with the same version ran the same register map. The in-process twin has no profile:
+// profile "synbench twin", version synbench's own.
+struct DeviceIdentity {
+  std::string device;   // "synrm_drive", "load_drive", "vfc_meter"
+  std::string profile;  // the profile's "name"
+  std::string version;
+  bool operator==(const DeviceIdentity&) const = default;
+};
+
 // Everything needed to know later how a sweep's points were obtained. JSON members that are
 // null are stored as SQL NULL.
 struct SweepMeta {
@@ -31,6 +44,21 @@ struct SweepMeta {
   synbench::Json bench_config;        // the bench configuration in use
   synbench::Json calibration;         // meter/sensor calibration, if any
   std::int64_t total_points = 0;              // points in the plan: indices 0 .. total_points-1
+  // The bench's identity (schema v9). Empty name or host: create_sweep stamps the store's
+  // (StoreOptions::bench), whose defaults are this machine's host name for both.
+  std::string bench_name;                     // --bench-name; defaults to the host name
+  std::string bench_host;                     // the host the sweep was created on
+  std::vector<DeviceIdentity> devices;        // empty: the store's
+  // A deterministic name a study shard finds its sweep again by (find_sweep_by_key); unique
+  // among the store's sweeps when set (create_sweep refuses a second one, errc::duplicate_key).
+  std::optional<std::string> key;
+};
+
+// What a store's process writes as its bench: stamped on every sweep created without one.
+struct BenchIdentity {
+  std::string name;   // "" -> host
+  std::string host;   // "" -> gethostname()
+  std::vector<DeviceIdentity> devices;
 };
 
 struct Sweep {

@@ -167,6 +167,11 @@ TEST(Migrations, AVersion1FileGainsTheLaterColumns) {
   }
   {
     Raw raw(path);
+    raw.exec("DROP INDEX sweeps_by_key");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN key");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN devices_json");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN bench_host");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN bench_name");
     raw.exec("ALTER TABLE points DROP COLUMN efficiency_u_repeat");
     raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_repeat_W");
     raw.exec("ALTER TABLE points DROP COLUMN im_u_repeat_A");
@@ -218,6 +223,11 @@ TEST(Migrations, AVersion3FileGainsTheSweepOwner) {
   }
   {
     Raw raw(path);
+    raw.exec("DROP INDEX sweeps_by_key");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN key");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN devices_json");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN bench_host");
+    raw.exec("ALTER TABLE sweeps DROP COLUMN bench_name");
     raw.exec("ALTER TABLE points DROP COLUMN efficiency_u_repeat");
     raw.exec("ALTER TABLE points DROP COLUMN pdcm_u_repeat_W");
     raw.exec("ALTER TABLE points DROP COLUMN im_u_repeat_A");
@@ -250,8 +260,8 @@ TEST(Migrations, EachStepIsOneTransaction) {
   TempDir dir;
   Raw raw(dir / "steps.db");
   const Migration steps[] = {
-      {1, "one table", "CREATE TABLE a (x INTEGER);"},
-      {2, "fails after its first statement", "CREATE TABLE b (x INTEGER); INSERT INTO nowhere VALUES (1);"},
+      {1, "one table", "CREATE TABLE a (x INTEGER);", ""},
+      {2, "fails after its first statement", "CREATE TABLE b (x INTEGER); INSERT INTO nowhere VALUES (1);", ""},
   };
   const auto s = detail::migrate(raw.get(), steps);
   ASSERT_FALSE(s);
@@ -259,7 +269,7 @@ TEST(Migrations, EachStepIsOneTransaction) {
   EXPECT_EQ(raw.one("PRAGMA user_version"), "1");
   EXPECT_EQ(raw.column("SELECT name FROM sqlite_schema ORDER BY name"), std::vector<std::string>{"a"});
   // With the step fixed, migration continues from version 1.
-  const Migration fixed[] = {steps[0], {2, "fixed", "CREATE TABLE b (x INTEGER);"}};
+  const Migration fixed[] = {steps[0], {2, "fixed", "CREATE TABLE b (x INTEGER);", ""}};
   ASSERT_TRUE(detail::migrate(raw.get(), fixed));
   EXPECT_EQ(raw.one("PRAGMA user_version"), "2");
   EXPECT_EQ(raw.column("SELECT name FROM sqlite_schema ORDER BY name"), (std::vector<std::string>{"a", "b"}));
