@@ -6,6 +6,7 @@
 // calibration is common and cancels) and whether it is significant at 95 % (|diff| > 1.96 u);
 // insignificant bars are faded and hatched.
 // Both analyses come from GET /api/sweeps/{id}/analysis: the page only subtracts.
+import { onBench } from '../bench_label.js';
 import { api } from '../api.js';
 import { ChartCard, axis, PALETTE } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
@@ -133,8 +134,9 @@ export class Compare {
   }
 
   sweepName(id) {
-    const s = (this.r.app.sweeps || []).find((x) => x.id === id);
-    return s ? `sweep #${id} “${s.name}”` : `sweep #${id}`;
+    const all = this.r.app.sweeps || [];
+    const s = all.find((x) => x.id === id);
+    return s ? `sweep #${id} “${s.name}”${onBench(s, all)}` : `sweep #${id}`;
   }
 
   draw(cfg, speed, load) {

@@ -5,6 +5,7 @@ import { analysisConfigs } from '../analysis_configs.js';
 import { effMapOption, etaOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
 import { uncertaintyNote } from '../uncertainty_note.js';
 import { escapeHtml } from './live.js';
+import { onBench } from '../bench_label.js';
 import { ResultTables } from './tables.js';
 import { Compare } from './compare.js';
 import { keyboardPoints } from '../chart_keys.js';
@@ -77,12 +78,12 @@ export class ResultsView {
 
   fillSweeps(list) {
     const sel = $('#r-sweep');
-    const opts = list.slice().reverse().map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)} (${s.state}, ${s.points_stored} points)</option>`).join('');
+    const opts = list.slice().reverse().map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)}${escapeHtml(onBench(s, list))} (${s.state}, ${s.points_stored} points)</option>`).join('');
     if (sel.innerHTML !== opts) sel.innerHTML = opts || '<option value="">no sweeps yet</option>';
     if (this.sweepId) sel.value = String(this.sweepId);
     const vs = $('#r-vs');
     const vopts = '<option value="">no comparison</option>' + list.slice().reverse().filter((s) => s.points_stored > 0)
-      .map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)}</option>`).join('');
+      .map((s) => `<option value="${s.id}">#${s.id} ${escapeHtml(s.name)}${escapeHtml(onBench(s, list))}</option>`).join('');
     if (vs.innerHTML !== vopts) vs.innerHTML = vopts;
     vs.value = String(this.compare.vsId || '');
   }
