@@ -89,8 +89,8 @@ Result<PgConnection> PgConnection::connect(const std::string& conninfo, std::str
   // UTC timestamps, and no notices on stderr (an "already exists" notice is not news).
   PQsetNoticeProcessor(c.get(), [](void*, const char*) {}, nullptr);
   PgConnection conn(std::move(c), std::move(shown));
-  if (auto r = conn.exec("SET extra_float_digits = 3; SET TIME ZONE 'UTC'", "setting up the session"); !r)
-    return r.error();
+  if (auto s = conn.set_session("SET extra_float_digits = 3; SET TIME ZONE 'UTC'", "setting up the session"); !s)
+    return s.error();
   return conn;
 }
 
@@ -110,7 +110,7 @@ Result<PgResultPtr> PgConnection::exec(std::string_view sql, const PgParams& par
   if (PQstatus(conn_.get()) == CONNECTION_BAD) {
     PQreset(conn_.get());
     if (PQstatus(conn_.get()) != CONNECTION_OK) return error(what, nullptr);
-    PgResultPtr setup(PQexec(conn_.get(), "SET extra_float_digits = 3; SET TIME ZONE 'UTC'"));
+    if (auto s = exec_script(session_, "setting up the session again"); !s) return s.error();
   }
   const std::string text(sql);
   const auto values = params.pointers();
@@ -122,6 +122,12 @@ Result<PgResultPtr> PgConnection::exec(std::string_view sql, const PgParams& par
   const auto status = PQresultStatus(r.get());
   if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) return error(what, r.get());
   return r;
+}
+
+Status PgConnection::set_session(std::string sql, std::string_view what) {
+  if (auto s = exec_script(sql, what); !s) return s;
+  session_ += (session_.empty() ? "" : "; ") + sql;
+  return {};
 }
 
 Status PgConnection::exec_script(std::string_view sql, std::string_view what) {

@@ -81,6 +81,9 @@ class PgConnection {
   // Several statements without parameters (DDL), in one round trip.
   Status exec_script(std::string_view sql, std::string_view what);
 
+  // A SET run now and again after every reconnection (a reset session forgets its settings).
+  Status set_session(std::string sql, std::string_view what);
+
   const std::string& shown() const noexcept { return shown_; }
   Error error(std::string_view what, const PGresult* r) const;
 
@@ -91,6 +94,7 @@ class PgConnection {
   PgConnection(std::unique_ptr<PGconn, Closer> c, std::string shown) : conn_(std::move(c)), shown_(std::move(shown)) {}
   std::unique_ptr<PGconn, Closer> conn_;
   std::string shown_;
+  std::string session_;  // the SETs of every session, ';'-separated
 };
 
 // BEGIN ... COMMIT, rolled back if not committed (an early return on an error).

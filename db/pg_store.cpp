@@ -80,8 +80,8 @@ class PgBackend final : public Backend {
     if (options.max_page_count)
       return make_error(errc::unsupported, c_.shown() + ": max_page_count is SQLite's; PostgreSQL's size limits are "
                                                         "the server's (tablespace quotas, disk)");
-    if (auto r = c_.exec("SET lock_timeout = " + std::to_string(options.busy_timeout_ms), "setting lock_timeout"); !r)
-      return r.error();
+    if (auto s = c_.set_session("SET lock_timeout = " + std::to_string(options.busy_timeout_ms), "setting lock_timeout"); !s)
+      return s;
     if (auto s = migrate_pg(c_, migrations()); !s) return s;
     if (options.verify) {
       // A committed write, as on SQLite: a read-only role or a standby is refused here.

@@ -151,7 +151,7 @@ std::string parse_host_value(std::string text, const std::string& what) {
 
 ServeOptions parse_serve_options(const std::vector<std::string>& argv, const EnvLookup& env,
                                  const std::filesystem::path& default_web_dir) {
-  Args a(argv, {"--help", "--allow-remote-plain-http"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir"},
+  Args a(argv, {"--help", "--allow-remote-plain-http"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir", "--bench-name", "--db"},
          {"--allow-host", "--allow-origin"});
   if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
   ServeOptions o;
@@ -191,6 +191,11 @@ ServeOptions parse_serve_options(const std::vector<std::string>& argv, const Env
   }
   if (auto v = pick("--web-dir", "SYNBENCH_WEB_DIR", opt_path(file.web_dir))) o.web_dir = v->first;
   if (auto v = pick("--bench", "SYNBENCH_BENCH", opt_path(file.bench))) o.bench = v->first;
+  if (auto v = pick("--bench-name", "SYNBENCH_BENCH_NAME", std::nullopt)) o.bench_name = v->first;
+  if (auto v = pick("--db", "SYNBENCH_DB", std::nullopt)) {
+    if (v->first.empty()) throw UsageError(v->second, "needs a database file or a postgresql:// URL");
+    o.db = v->first;
+  }
 
   // The twin: a file from a flag or the environment replaces the config file's twin section.
   const auto twin_from = [&](const std::string& what, const std::string& path) {

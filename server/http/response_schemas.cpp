@@ -118,7 +118,12 @@ synbench::Json sweep_schema(bool with_plan) {
       {"started_at", nullable(kStr)},
       {"finished_at", nullable(kStr)},
       {"last_error", nullable(kStr)},
-      {"software_version", kStr}};
+      {"software_version", kStr},
+      {"bench", closed_object({{"name", kStr},
+                               {"host", kStr},
+                               {"devices", {{"type", "array"},
+                                            {"items", closed_object({{"device", kStr}, {"profile", kStr}, {"version", kStr}})}}}})},
+      {"key", nullable(kStr)}};
   if (with_plan) p["plan"] = {{"type", "object"}, {"description", "the sweep plan as run (docs/sweep-plan.md)"}};
   return closed_object(std::move(p));
 }

@@ -31,6 +31,8 @@ start)
   mkdir -p "$dir"
   if [ "$(id -u)" = 0 ]; then chown nobody "$dir"; fi
   chmod 700 "$dir"
+  as_owner test -w "$dir" ||
+    { echo "pg_cluster.sh: $dir is not reachable by the cluster's user (a parent directory closed to it?)" >&2; exit 1; }
   as_owner "$bin/initdb" -D "$dir/data" -A trust -U synbench -E UTF8 --locale=C --no-sync >"$dir/initdb.log" 2>&1 ||
     { cat "$dir/initdb.log" >&2; exit 1; }
   port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
