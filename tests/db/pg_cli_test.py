@@ -145,6 +145,9 @@ def served(work, sock, port, url):
         check(rest_im == db_im, "REST and psql read the same points (%s vs %s)" % (rest_im, db_im))
         who = psql(sock, port, "lab", "SELECT bench_name FROM sweeps WHERE id = %d" % sid)
         check(who == "served-bench", "the served sweep carries the daemon's bench name (%s)" % who)
+        _, sweep = d.request("GET", "/api/sweeps/%d" % sid)
+        check(sweep.get("bench", {}).get("name") == "served-bench" and len(sweep["bench"]["devices"]) == 3 and
+              sweep.get("key") is None, "GET /api/sweeps/{id} gives the bench's identity (%s)" % sweep.get("bench"))
         check(not os.path.exists(os.path.join(data_dir, "synbench.db")), "no SQLite file beside: the store is PostgreSQL")
         out = os.path.join(work, "report")
         r = subprocess.run([BIN, "report", str(sid), "--db", url, "--out", out], capture_output=True, text=True, timeout=120)
