@@ -6,11 +6,14 @@
   point, every index once;
 - `synbench serve --db postgresql://...`: a sweep created, run and read back over REST, and the
   same points read from PostgreSQL directly with psql; `synbench report --db` on it;
+- `synbench sweep --bench` over Modbus TCP against `synbench emulate`: the sweep carries the bench
+  config's profiles, by name, with their content versions;
 - a password in the URL is never printed by sweep, serve or report.
 
 Fails (exit 1) when PostgreSQL is not installed: it is a dependency (README's setup)."""
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -22,6 +25,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "server"))
 from checks import Checks  # noqa: E402
 from daemon import Daemon, wait_for  # noqa: E402
+import far_side as fs  # noqa: E402
 
 BIN = sys.argv[1]
 CLUSTER = os.path.join(HERE, "pg_cluster.sh")
@@ -58,6 +62,7 @@ def main():
         parallel_sweeps(work, cluster, port, url)
         killed_and_resumed(work, cluster, port, url)
         served(work, cluster, port, url)
+        over_modbus(work, cluster, port, url)
     finally:
         subprocess.run([CLUSTER, "stop", cluster])
         shutil.rmtree(work, ignore_errors=True)
@@ -157,6 +162,36 @@ def served(work, sock, port, url):
     finally:
         _, err = d.stop()
         check(SECRET not in (err or ""), "serve never prints or logs the password")
+
+
+def over_modbus(work, sock, port, url):
+    emu = fs.Emulator(BIN, os.path.join(work, "emulate.log"), args=["--duration-s", "300"])
+    try:
+        cfg = fs.write_bench_config(os.path.join(work, "bench.json"), fs.tcp_link(emu.port))
+        plan = os.path.join(work, "modbus.json")
+        with open(plan, "w") as f:
+            json.dump({"name": "over modbus", "window_s": 0.5,
+                       "dimensions": {"speed_rpm": [500], "load_Nm": [0.5], "angle_deg": [50, 54],
+                                      "configurations": [{"estimator": "encoder", "pwm": "capwm"}]}}, f)
+        r = subprocess.run([BIN, "sweep", plan, "--bench", cfg, "--db", url, "--bench-name", "modbus-bench", "--quiet"],
+                           capture_output=True, text=True, timeout=240)
+        check(r.returncode == 0, "sweep --bench over Modbus TCP into PostgreSQL (%s)" % r.stderr[-400:])
+        row = psql(sock, port, "lab", "SELECT s.devices_json, count(p.id) FROM sweeps s JOIN points p ON p.sweep_id = s.id "
+                   "WHERE s.bench_name = 'modbus-bench' GROUP BY s.id")
+        devices_text, n = row.rsplit("|", 1) if row else ("[]", "0")
+        check(n == "2", "both points over Modbus stored (%s)" % n)
+        devices = json.loads(devices_text)
+        names = {}
+        for kind, file in (("synrm_drive", "synrm_drive"), ("load_drive", "load_drive"), ("vfc_meter", "vfc_meter")):
+            with open(os.path.join(HERE, "..", "..", "drivers", "profiles", file + ".json")) as f:
+                names[kind] = json.load(f)["name"]
+        check([(d["device"], d["profile"]) for d in devices] == list(names.items()),
+              "the sweep names the bench config's profiles (%s)" % devices)
+        versions = [d["version"] for d in devices]
+        check(all(re.fullmatch(r"fnv1a64:[0-9a-f]{16}", v) for v in versions) and len(set(versions)) == 3,
+              "each with its own content version (%s)" % versions)
+    finally:
+        emu.stop()
 
 
 if __name__ == "__main__":
