@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstdlib>
+#include <fstream>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -42,6 +44,20 @@ std::string& error_text() {
 
 PgCluster* PgCluster::shared() {
   static std::unique_ptr<PgCluster> cluster = []() -> std::unique_ptr<PgCluster> {
+    // Under ctest, one cluster for all the test processes: the fixture test db_pg_cluster_start
+    // started it in $SYNBENCH_PG_CLUSTER (db_pg_cluster_stop removes it).
+    if (const char* shared_dir = std::getenv("SYNBENCH_PG_CLUSTER")) {
+      std::ifstream port_file(std::string(shared_dir) + "/port");
+      int port = 0;
+      if (!(port_file >> port)) {
+        error_text() = std::string("no PostgreSQL test cluster in ") + shared_dir +
+                       " (SYNBENCH_PG_CLUSTER): the ctest fixture db_pg_cluster_start did not start it";
+        return nullptr;
+      }
+      auto c = std::unique_ptr<PgCluster>(new PgCluster(shared_dir, port));
+      c->owned_ = false;
+      return c;
+    }
     char tmpl[] = "/tmp/synbench-pg-XXXXXX";
     if (!::mkdtemp(tmpl)) {
       error_text() = "cannot create a temporary directory for the PostgreSQL cluster";
@@ -61,7 +77,9 @@ PgCluster* PgCluster::shared() {
 
 const std::string& PgCluster::error() { return error_text(); }
 
-PgCluster::~PgCluster() { (void)run(std::string(SYNBENCH_PG_CLUSTER_SCRIPT) + " stop " + quoted(dir_)); }
+PgCluster::~PgCluster() {
+  if (owned_) (void)run(std::string(SYNBENCH_PG_CLUSTER_SCRIPT) + " stop " + quoted(dir_));
+}
 
 std::string PgCluster::url(const std::string& database) const {
   return "postgresql://synbench@127.0.0.1:" + std::to_string(port_) + "/" + database;

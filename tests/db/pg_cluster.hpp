@@ -1,5 +1,6 @@
-// The db tests' PostgreSQL server: one throwaway cluster per test program (tests/db/pg_cluster.sh
-// in a temporary directory), started at first use and removed at exit, and a fresh empty
+// The db tests' PostgreSQL server: one throwaway cluster (tests/db/pg_cluster.sh in a temporary
+// directory), started at first use and removed at exit, or under ctest the one the fixture test
+// db_pg_cluster_start started for every test process ($SYNBENCH_PG_CLUSTER); a fresh empty
 // database on it per test. When PostgreSQL is not installed, the tests that need it fail with
 // the script's message: they never pass silently.
 #pragma once
@@ -32,6 +33,7 @@ class PgCluster {
   std::string dir_;
   int port_ = 0;
   int databases_ = 0;
+  bool owned_ = true;  // started (and so stopped) by this process
 };
 
 }  // namespace synbench::db::testing

@@ -4,6 +4,7 @@
 #   pg_cluster.sh start DIR   initdb in DIR/data, start postgres with its unix socket in DIR and
 #                             on 127.0.0.1 at a free port; prints the port. As root (here and in
 #                             CI) the cluster runs as `nobody` (initdb refuses root).
+#                             (also written to DIR/port, for the tests that share it)
 #   pg_cluster.sh stop DIR    stops it and removes DIR.
 # The role is "synbench", trust authentication (nothing leaves the machine). Exit status 3 and
 # a message when PostgreSQL is not installed: the tests fail on that, they do not skip.
@@ -39,6 +40,7 @@ start)
   as_owner "$bin/pg_ctl" -D "$dir/data" -l "$dir/server.log" -w -t 60 \
     -o "-k $dir -p $port -c listen_addresses=127.0.0.1 -c max_connections=200" start >/dev/null ||
     { cat "$dir/server.log" >&2; exit 1; }
+  echo "$port" >"$dir/port"
   echo "$port"
   ;;
 stop)
