@@ -60,16 +60,17 @@ the default (docs/deployment.md):
                        digests, synbench.db the sweeps. On first start an operator token is
                        created, printed once on stderr and written to DIR/operator.token (0600)
   --config FILE        SYNBENCH_CONFIG: the daemon config file (JSON; keys listen, data_dir,
-                       twin, bench, web_dir, allow_hosts, allow_origins; paths relative to it)
+                       twin, bench, web_dir, allow_hosts, allow_origins, db, bench_name; paths
+                       relative to it)
   --twin-config FILE   SYNBENCH_TWIN_CONFIG, "twin": the twin config (docs/emulator-config.md);
                        its firmware limits also bound the setpoints with --bench
   --bench FILE         SYNBENCH_BENCH, "bench": a bench config (docs/bench-config.md): the real
                        drives over Modbus RTU/TCP, or `synbench emulate`, instead of the twin
-  --db FILE|URL        SYNBENCH_DB: the store instead of DIR/synbench.db: a SQLite file, or a
+  --db FILE|URL        SYNBENCH_DB, "db": the store instead of DIR/synbench.db: a SQLite file, or a
                        PostgreSQL lab store (postgresql://user@host:port/db, or libpq's
                        host=/socket/dir dbname=db form; docs/database.md). Its password is
                        never printed
-  --bench-name NAME    SYNBENCH_BENCH_NAME: this bench's name, stored with every sweep next to
+  --bench-name NAME    SYNBENCH_BENCH_NAME, "bench_name": this bench's name, stored with every sweep next to
                        the host and the device profiles' versions (default: the host name)
   --web-dir DIR        SYNBENCH_WEB_DIR, "web_dir": the web dashboard's built files, served at /
                        (default: the source tree's web/dist)

@@ -89,6 +89,13 @@ TEST(ServeOptions, TheStoreAndTheBenchNameFromAFlagOrTheEnvironment) {
   EXPECT_EQ(o.db, "host=/run/pg dbname=lab");
   EXPECT_EQ(o.bench_name, "bench-3");
   EXPECT_NE(error_of({"--db", ""}).find("--db"), std::string::npos);
+  // The config file's keys: a file relative to it, a URL as given.
+  const auto cfg = write_file("db.json", R"({"db": "lab.db", "bench_name": "bench-4"})");
+  o = parse_serve_options({"--config", cfg.string()}, Env{}.lookup(), "/web");
+  EXPECT_EQ(o.db, (cfg.parent_path() / "lab.db").string());
+  EXPECT_EQ(o.bench_name, "bench-4");
+  const auto url_cfg = write_file("db-url.json", R"({"db": "postgresql://lab@db.lab/lab"})");
+  EXPECT_EQ(parse_serve_options({"--config", url_cfg.string()}, Env{}.lookup(), "/web").db, "postgresql://lab@db.lab/lab");
 }
 
 TEST(ServeOptions, TwinSectionOverlaysTheDefaults) {
