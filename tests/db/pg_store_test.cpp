@@ -161,6 +161,13 @@ TEST_F(PgStoreTest, ErrorsCarryLibpqsTextAndSqlstateButNeverThePassword) {
   EXPECT_EQ(dup.code(), errc::duplicate_point);
   const auto bad = ok.add_event(999, EventKind::log, "x");
   EXPECT_EQ(bad.code(), errc::not_found);
+  // A refusal the store has no word for keeps the server's own text and its SQLSTATE.
+  sql("ALTER TABLE points ADD CONSTRAINT only_index_0 CHECK (point_index < 1)");
+  const auto refused = ok.insert_point(id, 1, testing::sample_record(1));
+  EXPECT_EQ(refused.code(), errc::invalid_argument);
+  EXPECT_NE(refused.error().message.find("only_index_0"), std::string::npos) << refused.error().message;
+  EXPECT_NE(refused.error().message.find("(SQLSTATE 23514)"), std::string::npos) << refused.error().message;
+  EXPECT_NE(refused.error().message.find("storing point 1 of sweep"), std::string::npos) << refused.error().message;
 }
 
 TEST_F(PgStoreTest, ALostConnectionIsReportedAndTheNextCallReconnects) {
