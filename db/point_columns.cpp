@@ -7,6 +7,7 @@
 #include <string_view>
 #include <utility>
 
+#include "db/pg.hpp"
 #include "db/sqlite.hpp"
 #include "drivers/json.hpp"
 
@@ -21,8 +22,8 @@ constexpr bool kNested = HasFieldTable<bench::held_t<T>>;
 
 // --- binding ---
 
-template <class T>
-void bind_value(Statement& st, int i, const T& v) {
+template <class St, class T>
+void bind_value(St& st, int i, const T& v) {
   if constexpr (std::is_same_v<T, double>) {
     if (std::isnan(v)) st.bind_null(i);
     else st.bind(i, v);
@@ -40,8 +41,8 @@ void bind_value(Statement& st, int i, const T& v) {
   }
 }
 
-template <class T>
-void bind_value(Statement& st, int i, const std::optional<T>& v) {
+template <class St, class T>
+void bind_value(St& st, int i, const std::optional<T>& v) {
   if (v) bind_value(st, i, *v);
   else st.bind_null(i);
 }
@@ -73,8 +74,8 @@ Status read_object(const std::string& text, std::string_view column, S& s) {
   return status;
 }
 
-template <class T>
-Status read_value(const Statement& st, int i, std::string_view column, T& v) {
+template <class Row, class T>
+Status read_value(const Row& st, int i, std::string_view column, T& v) {
   if constexpr (std::is_same_v<T, double>) {
     v = st.is_null(i) ? std::numeric_limits<double>::quiet_NaN() : st.real(i);
   } else if constexpr (std::is_same_v<T, bool>) {
@@ -97,8 +98,8 @@ Status read_value(const Statement& st, int i, std::string_view column, T& v) {
   return {};
 }
 
-template <class T>
-Status read_value(const Statement& st, int i, std::string_view column, std::optional<T>& v) {
+template <class Row, class T>
+Status read_value(const Row& st, int i, std::string_view column, std::optional<T>& v) {
   if (st.is_null(i)) {
     v.reset();
     return {};
@@ -123,12 +124,14 @@ const std::vector<std::string>& record_columns() {
   return columns;
 }
 
-void bind_record(Statement& st, int first, const bench::PointRecord& r) {
+template <class Params>
+void bind_record(Params& st, int first, const bench::PointRecord& r) {
   int i = first;
   bench::for_each_field(bench::kPointRecordFields, [&](const auto& f) { bind_value(st, i++, r.*f.member); });
 }
 
-Status read_record(const Statement& st, int first, bench::PointRecord& r) {
+template <class Row>
+Status read_record(const Row& st, int first, bench::PointRecord& r) {
   const auto& columns = record_columns();
   Status status;
   int k = 0;
@@ -138,5 +141,10 @@ Status read_record(const Statement& st, int first, bench::PointRecord& r) {
   });
   return status;
 }
+
+template void bind_record(Statement&, int, const bench::PointRecord&);
+template void bind_record(PgParams&, int, const bench::PointRecord&);
+template Status read_record(const Statement&, int, bench::PointRecord&);
+template Status read_record(const PgRow&, int, bench::PointRecord&);
 
 }  // namespace synbench::db::detail

@@ -12,7 +12,9 @@
 
 namespace synbench::db::detail {
 
-class Statement;
+class Statement;  // SQLite (db/sqlite.hpp)
+class PgParams;   // PostgreSQL (db/pg.hpp)
+class PgRow;
 
 // One column per field of the table, in its order; a field with a table of its own (truth) is
 // one column of JSON text named "<field>_json".
@@ -21,9 +23,13 @@ const std::vector<std::string>& record_columns();
 
 // Binds the record to parameters first, first + 1, ... in record_columns()' order. A NaN (which
 // SQLite cannot store) is bound as NULL: in a required number it reads back as NaN.
-void bind_record(Statement& st, int first, const bench::PointRecord& r);
+// For Statement and PgParams.
+template <class Params>
+void bind_record(Params& st, int first, const bench::PointRecord& r);
 // Reads the record from a row's columns first, first + 1, ...: errc::bad_record naming the
 // column for a value the record cannot hold.
-Status read_record(const Statement& st, int first, bench::PointRecord& r);
+// For Statement and PgRow.
+template <class Row>
+Status read_record(const Row& st, int first, bench::PointRecord& r);
 
 }  // namespace synbench::db::detail

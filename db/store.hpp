@@ -1,4 +1,9 @@
-// synbench's SQLite store: sweeps with their metadata, one row per measured point, events.
+// synbench's store: sweeps with their metadata, one row per measured point, events. One type
+// for the rest of synbench over two backends (db/backend.hpp): a SQLite file, the embedded
+// default for one bench, or a PostgreSQL database, the lab store several benches write into
+// (docs/database.md). The same schema and migrations on both; what follows is SQLite's side,
+// and docs/database.md says where PostgreSQL differs (durability: COMMIT per point with the
+// server's synchronous_commit; concurrency: row locks; no file_lost, pragmas or max_page_count).
 //
 // Durability: WAL with synchronous=FULL, and one transaction per point, so insert_point returns
 // only once its point is on disk; a crash (process or power) loses at most the point in flight,
@@ -33,9 +38,20 @@
 
 namespace synbench::db {
 
+namespace detail {
+class Backend;
+}
+
 // Wall-clock UTC with milliseconds, ISO 8601 ("2026-12-04T05:01:02.345Z"): the store's
 // timestamps; sorts as text and SQLite's date functions read it.
 std::string now_utc();
+
+// Whether `target` names a PostgreSQL database rather than a file: a postgresql:// or
+// postgres:// URL, or libpq's key=value form ("host=/run/pg dbname=lab"). A file whose name
+// looks like the latter is reached as ./host=...
+bool is_postgres_target(std::string_view target);
+// `target` as it may be printed or logged: a URL's or key=value password as ***.
+std::string shown_target(std::string_view target);
 
 struct StoreOptions {
   int busy_timeout_ms = 5000;  // how long a write waits for another connection's lock
@@ -44,7 +60,8 @@ struct StoreOptions {
   // the file: for a process's start (the daemon, `synbench sweep`), not for every connection.
   bool verify = false;
   // SQLite's max_page_count for this connection, if set: a size limit, past which writes fail
-  // with errc::disk_full as on a full disk (the tests' way to fill the disk).
+  // with errc::disk_full as on a full disk (the tests' way to fill the disk). PostgreSQL
+  // refuses it (errc::unsupported). busy_timeout_ms is its lock_timeout.
   std::optional<std::int64_t> max_page_count;
   // Told of every failure of the storage itself (is_storage_failure: SQLite, the file, the disk),
   // with the message the caller gets; not of refusals such as an unknown sweep. For the log.
@@ -62,7 +79,10 @@ class Store {
   // another application's database (errc::not_synbench), a file SQLite could open only for
   // reading (errc::read_only), and with options.verify a damaged (errc::corrupt) or unwritable
   // one.
-  static Result<Store> open(const std::filesystem::path& path, const StoreOptions& options = {});
+  // A PostgreSQL target (is_postgres_target) connects, refuses a database of another application
+  // (errc::not_synbench) or a newer schema, and migrates under an advisory lock; errors name
+  // the target with its password redacted and carry libpq's text and SQLSTATE.
+  static Result<Store> open(const std::filesystem::path& target, const StoreOptions& options = {});
 
   Store(Store&&) noexcept;
   Store& operator=(Store&&) noexcept;
@@ -70,6 +90,9 @@ class Store {
   Store& operator=(const Store&) = delete;
   ~Store();
 
+  enum class Kind { sqlite, postgres };
+  Kind kind() const noexcept { return kind_; }
+  // The file, or the PostgreSQL target with its password redacted.
   const std::filesystem::path& path() const;
 
   // --- sweeps ---
@@ -122,15 +145,18 @@ class Store {
 
   // --- maintenance ---
   // PRAGMA integrity_check and foreign_key_check; errc::corrupt with their findings if not ok.
+  // On PostgreSQL (which enforces its constraints on every write): orphan rows, unknown states.
   Status integrity_check();
   // The value of a pragma on this connection, as text (e.g. "wal", "2"); name is [a-z_]+.
+  // errc::unsupported on PostgreSQL.
   Result<std::string> pragma(std::string_view name);
 
  private:
-  struct Impl;
-  explicit Store(std::unique_ptr<Impl> impl);
-  Impl& impl() const;
-  std::unique_ptr<Impl> impl_;
+  Store(std::unique_ptr<detail::Backend> backend, std::string shown, Kind kind);
+  detail::Backend& impl() const;
+  std::unique_ptr<detail::Backend> backend_;
+  std::filesystem::path path_;
+  Kind kind_ = Kind::sqlite;
 };
 
 }  // namespace synbench::db

@@ -1,6 +1,8 @@
 // Buses, clock and profile devices from a bench config.
 #include "server/cli/bench_setup.hpp"
 
+#include "db/bench_identity.hpp"
+
 #include <algorithm>
 
 #include "drivers/bus/modbus_bus.hpp"
@@ -182,6 +184,24 @@ class TwinBackend final : public app::BenchBackend {
 std::unique_ptr<app::BenchBackend> make_backend(std::optional<LoadedBench> bench, const emulator::TwinConfig& twin) {
   if (bench) return std::make_unique<ConfiguredBackend>(std::move(*bench), twin);
   return std::make_unique<TwinBackend>(twin);
+}
+
+db::BenchIdentity bench_identity(const std::optional<LoadedBench>& bench, const std::string& name) {
+  db::BenchIdentity id;
+  id.name = name;
+  if (!bench) {
+    id.devices = db::twin_devices();
+    return id;
+  }
+  using drivers::DeviceKind;
+  for (const auto& [kind, device] : {std::pair{DeviceKind::synrm_drive, "synrm_drive"},
+                                     std::pair{DeviceKind::load_drive, "load_drive"},
+                                     std::pair{DeviceKind::vfc_meter, "vfc_meter"}}) {
+    const auto& file = bench->config.device(kind).profile;
+    auto d = db::device_identity(device, file);
+    id.devices.push_back(d ? std::move(*d) : db::DeviceIdentity{device, file.string(), "unreadable"});
+  }
+  return id;
 }
 
 }  // namespace synbench::cli

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "db/types.hpp"
 #include "drivers/bench_config.hpp"
 #include "drivers/profile_devices/profile_bench.hpp"
 #include "emulator/twin_config.hpp"
@@ -34,6 +35,12 @@ struct LoadedBench {
   drivers::BenchProfiles profiles;
 };
 LoadedBench load_bench_or_throw(const std::string& file, const std::string& flag);
+
+// The identity every sweep this process stores carries (docs/database.md "Bench identity"):
+// `name` (--bench-name; "" = the host name), and the bench config's profiles with their
+// versions, or the twin's devices without one. A profile file that cannot be read is named
+// by its path with version "unreadable" (it was read moments ago by load_bench_or_throw).
+db::BenchIdentity bench_identity(const std::optional<LoadedBench>& bench, const std::string& name);
 
 class ConfiguredBench {
  public:

@@ -25,7 +25,8 @@ left out; and the sweep's points as CSV beside it. Prints the two paths.
   DIR/synbench-report-ID-NAME-YYYY-MM-DD.csv
 
 options:
-  --db FILE    database file (default synbench.db; must exist)
+  --db FILE|URL  database file (default synbench.db; must exist), or a PostgreSQL lab store
+               (postgresql://user@host:port/db; docs/database.md)
   --out DIR    directory to write to (default: the current one; created if missing)
   --help       this text
 
@@ -50,7 +51,7 @@ int report_command(const std::vector<std::string>& argv) {
     id = v;
     if (auto d = a.text("--db")) db_path = *d;
     if (auto o = a.text("--out")) out_dir = *o;
-    if (!std::filesystem::is_regular_file(db_path))
+    if (!db::is_postgres_target(db_path.string()) && !std::filesystem::is_regular_file(db_path))
       throw UsageError("--db", "no database at '" + db_path.string() + "'");
   } catch (const UsageError& e) {
     std::cerr << "synbench report: " << e.what() << "\n";
@@ -58,7 +59,7 @@ int report_command(const std::vector<std::string>& argv) {
   }
   auto store = db::Store::open(db_path);
   if (!store) {
-    std::cerr << "synbench report: " << db_path.string() << ": " << store.error().message << "\n";
+    std::cerr << "synbench report: " << db::shown_target(db_path.string()) << ": " << store.error().message << "\n";
     return 1;
   }
   auto report = report::make_sweep_report(*store, id, report::current_context());

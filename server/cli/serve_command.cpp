@@ -39,7 +39,8 @@
 namespace synbench::cli {
 
 const char* const kServeHelp = R"(usage: synbench serve [--listen HOST:PORT] [--data-dir DIR] [--config FILE]
-                      [--twin-config FILE] [--bench FILE] [--web-dir DIR]
+                      [--twin-config FILE] [--bench FILE] [--bench-name NAME] [--db FILE|URL]
+                      [--web-dir DIR]
                       [--allow-host NAME:PORT]... [--allow-origin ORIGIN]...
 
 Runs the synbench daemon on one port: the REST API (docs/api.md; OpenAPI document at
@@ -59,11 +60,18 @@ the default (docs/deployment.md):
                        digests, synbench.db the sweeps. On first start an operator token is
                        created, printed once on stderr and written to DIR/operator.token (0600)
   --config FILE        SYNBENCH_CONFIG: the daemon config file (JSON; keys listen, data_dir,
-                       twin, bench, web_dir, allow_hosts, allow_origins; paths relative to it)
+                       twin, bench, web_dir, allow_hosts, allow_origins, db, bench_name; paths
+                       relative to it)
   --twin-config FILE   SYNBENCH_TWIN_CONFIG, "twin": the twin config (docs/emulator-config.md);
                        its firmware limits also bound the setpoints with --bench
   --bench FILE         SYNBENCH_BENCH, "bench": a bench config (docs/bench-config.md): the real
                        drives over Modbus RTU/TCP, or `synbench emulate`, instead of the twin
+  --db FILE|URL        SYNBENCH_DB, "db": the store instead of DIR/synbench.db: a SQLite file, or a
+                       PostgreSQL lab store (postgresql://user@host:port/db, or libpq's
+                       host=/socket/dir dbname=db form; docs/database.md). Its password is
+                       never printed
+  --bench-name NAME    SYNBENCH_BENCH_NAME, "bench_name": this bench's name, stored with every sweep next to
+                       the host and the device profiles' versions (default: the host name)
   --web-dir DIR        SYNBENCH_WEB_DIR, "web_dir": the web dashboard's built files, served at /
                        (default: the source tree's web/dist)
   --allow-host NAME:PORT
@@ -138,7 +146,10 @@ int serve_command(const std::vector<std::string>& argv) {
   db::StoreOptions store_options;
   store_options.verify = true;
   store_options.on_error = db_error_logger("synbench serve: ");
-  auto store = db::Store::open(data_dir / "synbench.db", store_options);
+  store_options.bench = bench_identity(real_bench, options.bench_name);
+  // The lab store (PostgreSQL) when --db names one, else the data directory's SQLite file.
+  const std::filesystem::path db_target = options.db.empty() ? data_dir / "synbench.db" : std::filesystem::path(options.db);
+  auto store = db::Store::open(db_target, store_options);
   if (!store) {
     std::cerr << "synbench serve: cannot use the database: " << store.error().message << "\n";
     return 1;
@@ -175,7 +186,7 @@ int serve_command(const std::vector<std::string>& argv) {
   // The estimate, exports and analyses on a thread of their own: the io thread stays free for
   // the E-stop.
   http::Worker worker;
-  http::add_sweep_routes(router, *store, bench, control, worker, data_dir / "synbench.db", bench_meta);
+  http::add_sweep_routes(router, *store, bench, control, worker, db_target, bench_meta);
   // The telemetry trace of the last run, before this one's with the down time as a gap; saved
   // every 30 s on the worker (atomically) and at the end, so a restart keeps it.
   const auto history_file = data_dir / "telemetry-history.bin";

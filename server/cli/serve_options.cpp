@@ -1,6 +1,8 @@
 // Flags, environment and config file of `synbench serve`; see serve_options.hpp.
 #include "server/cli/serve_options.hpp"
 
+#include "db/store.hpp"
+
 #include <cstdlib>
 
 #include "drivers/json.hpp"
@@ -48,7 +50,7 @@ std::string host_value_problem(const std::string& text) {
 
 // The daemon config file: every key optional, unknown keys rejected, paths relative to the file.
 struct FileSettings {
-  std::optional<std::string> listen;
+  std::optional<std::string> listen, db, bench_name;
   bool allow_remote_plain_http = false;
   std::optional<std::filesystem::path> data_dir, web_dir, bench;
   std::optional<synbench::Json> twin;  // an object, or a file name resolved to its contents
@@ -67,7 +69,7 @@ FileSettings read_config_file(const std::filesystem::path& file, const std::stri
   FileSettings s;
   if (doc.object()) {
     doc.reject_unknown({"listen", "data_dir", "web_dir", "bench", "twin", "allow_hosts", "allow_origins",
-                        "allow_remote_plain_http"});
+                        "allow_remote_plain_http", "db", "bench_name"});
     const auto base = file.parent_path();
     const auto path = [&](std::string_view key) -> std::optional<std::filesystem::path> {
       const auto t = doc[key].text(true);
@@ -94,6 +96,9 @@ FileSettings read_config_file(const std::filesystem::path& file, const std::stri
     s.data_dir = path("data_dir");
     s.web_dir = path("web_dir");
     s.bench = path("bench");
+    // A database file relative to the config file, as every path in it; a PostgreSQL URL as given.
+    if (auto d = doc["db"].text(true)) s.db = db::is_postgres_target(*d) ? *d : path("db")->string();
+    s.bench_name = doc["bench_name"].text(true);
     if (const auto twin = doc["twin"]; twin.present()) {
       if (twin.json().is_object()) s.twin = twin.json();
       else if (twin.json().is_string()) s.twin_file = path("twin");
@@ -151,7 +156,7 @@ std::string parse_host_value(std::string text, const std::string& what) {
 
 ServeOptions parse_serve_options(const std::vector<std::string>& argv, const EnvLookup& env,
                                  const std::filesystem::path& default_web_dir) {
-  Args a(argv, {"--help", "--allow-remote-plain-http"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir"},
+  Args a(argv, {"--help", "--allow-remote-plain-http"}, {"--listen", "--data-dir", "--config", "--twin-config", "--bench", "--web-dir", "--bench-name", "--db"},
          {"--allow-host", "--allow-origin"});
   if (!a.positional().empty()) throw UsageError(a.positional().front(), "unexpected argument");
   ServeOptions o;
@@ -191,6 +196,11 @@ ServeOptions parse_serve_options(const std::vector<std::string>& argv, const Env
   }
   if (auto v = pick("--web-dir", "SYNBENCH_WEB_DIR", opt_path(file.web_dir))) o.web_dir = v->first;
   if (auto v = pick("--bench", "SYNBENCH_BENCH", opt_path(file.bench))) o.bench = v->first;
+  if (auto v = pick("--bench-name", "SYNBENCH_BENCH_NAME", file.bench_name)) o.bench_name = v->first;
+  if (auto v = pick("--db", "SYNBENCH_DB", file.db)) {
+    if (v->first.empty()) throw UsageError(v->second, "needs a database file or a postgresql:// URL");
+    o.db = v->first;
+  }
 
   // The twin: a file from a flag or the environment replaces the config file's twin section.
   const auto twin_from = [&](const std::string& what, const std::string& path) {

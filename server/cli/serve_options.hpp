@@ -23,6 +23,9 @@ struct ServeOptions {
   std::filesystem::path web_dir;                 // set from the compiled-in default by the caller
   emulator::TwinConfig twin;                     // the twin's config, and the limits of setpoints
   std::optional<std::filesystem::path> bench;    // a bench config: real drives or `synbench emulate`
+  std::string bench_name;                        // stored with every sweep; "" = the host name
+  // The store: a SQLite file, or a PostgreSQL URL (docs/database.md); "" = data_dir/synbench.db.
+  std::string db;
   std::vector<std::string> allow_hosts;          // extra Host values ("name:port"), lower case
   std::vector<std::string> allow_origins;        // extra WebSocket origins ("scheme://host[:port]")
   // A --listen address other than loopback is refused unless this confirms it: the API is plain

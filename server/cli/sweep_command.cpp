@@ -41,10 +41,14 @@ committed to the SQLite database before the next one starts; a sweep interrupted
 fault or Ctrl-C resumes at its first missing point.
 
 options:
-  --db FILE           database file (default synbench.db; created if missing)
+  --db FILE|URL       database file (default synbench.db; created if missing), or a PostgreSQL
+                      lab store: postgresql://user@host:port/db or host=/socket/dir dbname=db
+                      (docs/database.md; its password is never printed)
   --resume ID         continue sweep ID from the database (its stored plan is used)
   --config FILE       twin config JSON (docs/emulator-config.md)
   --bench FILE        bench config JSON (docs/bench-config.md): its drives instead of the twin
+  --bench-name NAME   this bench's name, stored with the sweep next to its host and device
+                      profiles' versions (default: the host name; docs/database.md)
   --export-csv FILE   write the sweep's points as CSV when it ends
   --export-json FILE  write the sweep's points as JSON when it ends
   --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
@@ -140,9 +144,10 @@ int sweep_command(const std::vector<std::string>& argv) {
   bool quiet = false, print_committed = false;
   std::optional<LoadedBench> loaded;
   std::string bench_file;
+  std::string bench_name;
   try {
     Args a(argv, {"--quiet", "--print-committed", "--help"},
-           {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis"});
+           {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis", "--bench-name"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
       return 0;
@@ -150,6 +155,7 @@ int sweep_command(const std::vector<std::string>& argv) {
     quiet = a.has("--quiet");
     print_committed = a.has("--print-committed");
     if (auto v = a.text("--db")) db_path = *v;
+    if (auto v = a.text("--bench-name")) bench_name = *v;
     csv = a.text("--export-csv");
     json_out = a.text("--export-json");
     analysis_out = a.text("--analysis");
@@ -200,6 +206,7 @@ int sweep_command(const std::vector<std::string>& argv) {
   db::StoreOptions store_options;
   store_options.verify = true;
   store_options.on_error = db_error_logger("synbench sweep: ");
+  store_options.bench = bench_identity(loaded, bench_name);
   auto opened = db::Store::open(db_path, store_options);
   if (!opened) {
     std::cerr << "synbench sweep: --db: " << opened.error().message << "\n";
@@ -252,7 +259,7 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
     id = *created;
   }
-  if (!quiet) std::cerr << "sweep " << id << " (" << db_path << "): " << stored.size() << " points stored before this run\n";
+  if (!quiet) std::cerr << "sweep " << id << " (" << store.path().string() << "): " << stored.size() << " points stored before this run\n";
 
   auto backend = make_backend(std::move(loaded), config);
   const app::BenchDescription& bench = backend->description();
@@ -329,7 +336,7 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
   }
   if (!quiet)
-    std::cerr << "sweep " << id << " " << db::name(final_state) << ": " << rows->size() << " points in " << db_path
+    std::cerr << "sweep " << id << " " << db::name(final_state) << ": " << rows->size() << " points in " << store.path().string()
               << (engine_error.empty() ? "" : " (" + engine_error + ")") << "\n";
   return status;
 }

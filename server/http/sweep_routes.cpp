@@ -37,7 +37,7 @@ synbench::Json sweep_json(const db::Sweep& s, bool with_plan) {
                       {"finished_at", optional_json(s.finished_at)},
                       {"last_error", optional_json(s.last_error)},
                       {"software_version", s.meta.software_version}};
-  // Which bench measured it (several benches may share one store): name, host, device profiles.
+  // The bench the sweep ran on (docs/database.md "Bench identity"): "" on sweeps from before.
   synbench::Json devices = synbench::Json::array();
   for (const auto& d : s.meta.devices)
     devices.push_back({{"device", d.device}, {"profile", d.profile}, {"version", d.version}});

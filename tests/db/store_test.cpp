@@ -1,4 +1,5 @@
-// The store on real SQLite files: sweeps and their states, every record field through the
+// The store on both backends, a real SQLite file and a real PostgreSQL database (the test
+// cluster, tests/db/pg_cluster.hpp): sweeps and their states, every record field through the
 // database, duplicates, missing indices, events, integrity.
 #include "db/store.hpp"
 
@@ -14,6 +15,7 @@
 
 #include "bench/point_record_fields.hpp"
 
+#include "tests/db/pg_cluster.hpp"
 #include "tests/db/sample_records.hpp"
 
 namespace synbench::db {
@@ -23,11 +25,19 @@ using testing::exact_text;
 using testing::sample_record;
 using testing::TempDir;
 
-class StoreTest : public ::testing::Test {
+class StoreTest : public ::testing::TestWithParam<Store::Kind> {
  protected:
   void SetUp() override {
-    auto s = Store::open(dir_ / "store.db");
+    if (GetParam() == Store::Kind::sqlite) {
+      target_ = (dir_ / "store.db").string();
+    } else {
+      auto* cluster = testing::PgCluster::shared();
+      ASSERT_NE(cluster, nullptr) << testing::PgCluster::error();
+      target_ = cluster->url(cluster->create_database());
+    }
+    auto s = Store::open(target_);
     ASSERT_TRUE(s) << s.error().message;
+    ASSERT_EQ(s->kind(), GetParam());
     store_.emplace(std::move(*s));
   }
 
@@ -41,10 +51,21 @@ class StoreTest : public ::testing::Test {
   }
 
   TempDir dir_;
+  std::string target_;
   std::optional<Store> store_;
 };
 
-TEST_F(StoreTest, CreatesASweepWithItsMetadata) {
+std::string kind_name(const ::testing::TestParamInfo<Store::Kind>& i) {
+  return i.param == Store::Kind::sqlite ? "sqlite" : "postgres";
+}
+INSTANTIATE_TEST_SUITE_P(Backends, StoreTest, ::testing::Values(Store::Kind::sqlite, Store::Kind::postgres), kind_name);
+
+// What only a SQLite file can be asked: rows written behind the store's back with SQLite's
+// JSON functions.
+class SqliteStoreTest : public StoreTest {};
+INSTANTIATE_TEST_SUITE_P(Backends, SqliteStoreTest, ::testing::Values(Store::Kind::sqlite), kind_name);
+
+TEST_P(StoreTest, CreatesASweepWithItsMetadata) {
   SweepMeta meta;
   meta.name = "thesis grid, encoder";
   meta.plan = synbench::Json::parse(R"({"speeds_rpm":[500,1000],"loads_Nm":[0,1.5],"z":1,"a":2})");
@@ -73,7 +94,7 @@ TEST_F(StoreTest, CreatesASweepWithItsMetadata) {
   EXPECT_EQ(s->points_stored, 0);
 }
 
-TEST_F(StoreTest, RefusesBadSweepMetadata) {
+TEST_P(StoreTest, RefusesBadSweepMetadata) {
   SweepMeta meta;
   EXPECT_EQ(store_->create_sweep(meta).code(), errc::invalid_argument) << "no name";
   meta.name = "x";
@@ -82,7 +103,7 @@ TEST_F(StoreTest, RefusesBadSweepMetadata) {
   EXPECT_TRUE(store_->list_sweeps().value().empty());
 }
 
-TEST_F(StoreTest, ListsSweepsById) {
+TEST_P(StoreTest, ListsSweepsById) {
   const auto a = make_sweep(1, "a");
   const auto b = make_sweep(2, "b");
   const auto list = store_->list_sweeps();
@@ -94,7 +115,7 @@ TEST_F(StoreTest, ListsSweepsById) {
   EXPECT_EQ((*list)[1].meta.total_points, 2);
 }
 
-TEST_F(StoreTest, StateChangesStampTimesAndRecordEvents) {
+TEST_P(StoreTest, StateChangesStampTimesAndRecordEvents) {
   const auto id = make_sweep(2);
   ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
   const auto started = store_->get_sweep(id).value().started_at;
@@ -126,7 +147,7 @@ TEST_F(StoreTest, StateChangesStampTimesAndRecordEvents) {
                                                 "faulted -> running"}));
 }
 
-TEST_F(StoreTest, CompletedNeedsEveryPointAndIsFinal) {
+TEST_P(StoreTest, CompletedNeedsEveryPointAndIsFinal) {
   const auto id = make_sweep(2);
   ASSERT_TRUE(store_->set_sweep_state(id, SweepState::running));
   ASSERT_TRUE(store_->insert_point(id, 0, sample_record(0)));
@@ -145,7 +166,7 @@ TEST_F(StoreTest, CompletedNeedsEveryPointAndIsFinal) {
   EXPECT_EQ(store_->set_sweep_state(id, SweepState::created).code(), errc::invalid_transition);
 }
 
-TEST_F(StoreTest, UnknownSweepIsNotFound) {
+TEST_P(StoreTest, UnknownSweepIsNotFound) {
   EXPECT_EQ(store_->get_sweep(42).code(), errc::not_found);
   EXPECT_EQ(store_->set_sweep_state(42, SweepState::running).code(), errc::not_found);
   EXPECT_EQ(store_->insert_point(42, 0, sample_record(0)).code(), errc::not_found);
@@ -155,7 +176,7 @@ TEST_F(StoreTest, UnknownSweepIsNotFound) {
   EXPECT_EQ(store_->events(42).code(), errc::not_found);
 }
 
-TEST_F(StoreTest, EveryFieldRoundTripsExactly) {
+TEST_P(StoreTest, EveryFieldRoundTripsExactly) {
   constexpr std::int64_t kTotal = 60;  // covers every estimator, pwm, null pattern, truth, fault
   const auto id = make_sweep(kTotal);
   for (std::int64_t i = kTotal - 1; i >= 0; --i)  // stored out of order, read back by index
@@ -182,7 +203,7 @@ TEST_F(StoreTest, EveryFieldRoundTripsExactly) {
   EXPECT_FALSE((*rows)[13].record.fault_code_raw);
 }
 
-TEST_F(StoreTest, TheSamplesSetEveryField) {
+TEST_P(StoreTest, TheSamplesSetEveryField) {
   // The round trip above proves a field only if some sample gives it a value of its own: a field
   // added to the record and not to sample_record() fails here.
   const auto defaults = bench::to_json(bench::PointRecord{});
@@ -202,7 +223,7 @@ TEST_F(StoreTest, TheSamplesSetEveryField) {
   bench::for_each_field(bench::kTruthFields, [&](const auto& f) { EXPECT_TRUE(set.contains("truth." + std::string(f.name))) << f.name; });
 }
 
-TEST_F(StoreTest, AValueTheRecordCannotHoldIsABadRecordNamingItsColumn) {
+TEST_P(SqliteStoreTest, AValueTheRecordCannotHoldIsABadRecordNamingItsColumn) {
   // Another connection writes what the store never would; points() names the point and column.
   const auto read_after = [&](const std::string& set) -> std::string {
     const auto id = make_sweep(1);
@@ -232,7 +253,7 @@ TEST_F(StoreTest, AValueTheRecordCannotHoldIsABadRecordNamingItsColumn) {
   EXPECT_EQ(read_after("truth_json = json_set(truth_json, '$.pm_W', json('null'))"), "read: " + exact_text(nan_truth));
 }
 
-TEST_F(StoreTest, NanInARequiredFieldComesBackAsNan) {
+TEST_P(StoreTest, NanInARequiredFieldComesBackAsNan) {
   // SQLite cannot store NaN; the store writes NULL, which a required field reads as NaN.
   const auto id = make_sweep(1);
   auto r = sample_record(2);
@@ -246,7 +267,7 @@ TEST_F(StoreTest, NanInARequiredFieldComesBackAsNan) {
   EXPECT_EQ(back.speed_rpm, std::numeric_limits<double>::infinity());
 }
 
-TEST_F(StoreTest, DuplicatePointIsRejectedAndChangesNothing) {
+TEST_P(StoreTest, DuplicatePointIsRejectedAndChangesNothing) {
   const auto id = make_sweep(5);
   ASSERT_TRUE(store_->insert_point(id, 3, sample_record(3)));
   const auto before = store_->points(id).value();
@@ -265,14 +286,14 @@ TEST_F(StoreTest, DuplicatePointIsRejectedAndChangesNothing) {
   EXPECT_TRUE(store_->insert_point(id, 4, sample_record(4)));
 }
 
-TEST_F(StoreTest, IndexOutsideThePlanIsRejected) {
+TEST_P(StoreTest, IndexOutsideThePlanIsRejected) {
   const auto id = make_sweep(3);
   EXPECT_EQ(store_->insert_point(id, -1, sample_record(0)).code(), errc::invalid_argument);
   EXPECT_EQ(store_->insert_point(id, 3, sample_record(0)).code(), errc::invalid_argument);
   EXPECT_TRUE(store_->points(id).value().empty());
 }
 
-TEST_F(StoreTest, MissingIndicesAndWhereToResume) {
+TEST_P(StoreTest, MissingIndicesAndWhereToResume) {
   const auto id = make_sweep(10);
   EXPECT_EQ(store_->first_missing_index(id).value(), 0);
   for (const std::int64_t i : {0, 1, 2, 5, 9}) ASSERT_TRUE(store_->insert_point(id, i, sample_record(i)));
@@ -286,7 +307,7 @@ TEST_F(StoreTest, MissingIndicesAndWhereToResume) {
   EXPECT_TRUE(store_->missing_indices(empty).value().empty());
 }
 
-TEST_F(StoreTest, EventsPerSweepAndBenchWide) {
+TEST_P(StoreTest, EventsPerSweepAndBenchWide) {
   const auto a = make_sweep(1, "a");
   const auto b = make_sweep(1, "b");
   const auto e1 = store_->add_event(a, EventKind::fault, "overcurrent");
@@ -308,23 +329,20 @@ TEST_F(StoreTest, EventsPerSweepAndBenchWide) {
   for (std::size_t i = 1; i < all.size(); ++i) EXPECT_LT(all[i - 1].id, all[i].id);
 }
 
-TEST_F(StoreTest, ACommittedPointIsVisibleToAnotherConnectionAtOnce) {
+TEST_P(StoreTest, ACommittedPointIsVisibleToAnotherConnectionAtOnce) {
   // insert_point's transaction is over when it returns: a second connection (as a reader process
   // would) sees the point without the store closing or checkpointing.
   const auto id = make_sweep(2);
   ASSERT_TRUE(store_->insert_point(id, 1, sample_record(1)));
-  sqlite3* other = nullptr;
-  ASSERT_EQ(sqlite3_open_v2(store_->path().c_str(), &other, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
-  sqlite3_stmt* st = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(other, "SELECT count(*), max(point_index) FROM points", -1, &st, nullptr), SQLITE_OK);
-  ASSERT_EQ(sqlite3_step(st), SQLITE_ROW);
-  EXPECT_EQ(sqlite3_column_int(st, 0), 1);
-  EXPECT_EQ(sqlite3_column_int(st, 1), 1);
-  sqlite3_finalize(st);
-  sqlite3_close(other);
+  auto other = Store::open(target_);
+  ASSERT_TRUE(other) << other.error().message;
+  const auto rows = other->points(id).value();
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].index, 1);
+  EXPECT_EQ(exact_text(rows[0].record), exact_text(sample_record(1)));
 }
 
-TEST_F(StoreTest, IntegrityCheckPassesOnAFreshAndAUsedDatabase) {
+TEST_P(StoreTest, IntegrityCheckPassesOnAFreshAndAUsedDatabase) {
   EXPECT_TRUE(store_->integrity_check());
   const auto id = make_sweep(20);
   for (std::int64_t i = 0; i < 20; ++i) ASSERT_TRUE(store_->insert_point(id, i, sample_record(i)));
@@ -332,7 +350,7 @@ TEST_F(StoreTest, IntegrityCheckPassesOnAFreshAndAUsedDatabase) {
   EXPECT_TRUE(s) << (s ? "" : s.error().message);
 }
 
-TEST_F(StoreTest, ProgrammerErrorsThrow) {
+TEST_P(StoreTest, ProgrammerErrorsThrow) {
   Result<std::int64_t> failed = make_error(errc::not_found, "x");
   EXPECT_THROW(static_cast<void>(failed.value()), std::logic_error);
   Store moved = std::move(*store_);

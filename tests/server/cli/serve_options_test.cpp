@@ -75,6 +75,29 @@ TEST(ServeOptions, FlagBeatsEnvironmentBeatsFile) {
   EXPECT_EQ(o.data_dir, cfg.parent_path() / "data-from-file");  // untouched by the others
 }
 
+TEST(ServeOptions, TheStoreAndTheBenchNameFromAFlagOrTheEnvironment) {
+  auto o = parse_serve_options({}, Env{}.lookup(), "/web");
+  EXPECT_EQ(o.db, "") << "the data directory's synbench.db";
+  EXPECT_EQ(o.bench_name, "") << "the host name";
+  Env env;
+  env.vars["SYNBENCH_DB"] = "postgresql://lab@db.lab/lab";
+  env.vars["SYNBENCH_BENCH_NAME"] = "bench-2";
+  o = parse_serve_options({}, env.lookup(), "/web");
+  EXPECT_EQ(o.db, "postgresql://lab@db.lab/lab");
+  EXPECT_EQ(o.bench_name, "bench-2");
+  o = parse_serve_options({"--db", "host=/run/pg dbname=lab", "--bench-name", "bench-3"}, env.lookup(), "/web");
+  EXPECT_EQ(o.db, "host=/run/pg dbname=lab");
+  EXPECT_EQ(o.bench_name, "bench-3");
+  EXPECT_NE(error_of({"--db", ""}).find("--db"), std::string::npos);
+  // The config file's keys: a file relative to it, a URL as given.
+  const auto cfg = write_file("db.json", R"({"db": "lab.db", "bench_name": "bench-4"})");
+  o = parse_serve_options({"--config", cfg.string()}, Env{}.lookup(), "/web");
+  EXPECT_EQ(o.db, (cfg.parent_path() / "lab.db").string());
+  EXPECT_EQ(o.bench_name, "bench-4");
+  const auto url_cfg = write_file("db-url.json", R"({"db": "postgresql://lab@db.lab/lab"})");
+  EXPECT_EQ(parse_serve_options({"--config", url_cfg.string()}, Env{}.lookup(), "/web").db, "postgresql://lab@db.lab/lab");
+}
+
 TEST(ServeOptions, TwinSectionOverlaysTheDefaults) {
   const auto cfg = write_file("twin.json", R"({"twin": {"firmware": {"max_speed_rpm": 1200}}})");
   const auto o = parse_serve_options({"--config", cfg.string()}, Env{}.lookup(), "/web");
