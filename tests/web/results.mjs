@@ -3,7 +3,9 @@
 // labelled per run, the difference table equal to differences of the two analyses from REST,
 // points only in one run listed, the choice kept in the URL over a reload), the numeric tables
 // equal to the analysis at their printed precision and copied as CSV, a titled PNG export with
-// its file name, and the charts' points read with the keyboard only.
+// its file name, and the charts' points read with the keyboard only. The two sweeps come from two
+// benches sharing one store (`--bench-name`): the History view names each run's bench, filters by
+// bench, and opens two ticked runs of different benches in the comparison.
 //
 // usage: node results.mjs path/to/synbench SOURCE_DIR ARTIFACT_DIR
 import fs from 'node:fs';
@@ -20,13 +22,13 @@ const pw = loadPlaywright(webDir);
 const dataDir = path.join(tmpDir('synbench-web-results-'), 'data');
 fs.mkdirSync(dataDir, { recursive: true });
 const configurations = [{ estimator: 'encoder', pwm: 'capwm' }, { estimator: 'ekf-basic', pwm: 'aspwm' }];
-const sweep = (name, loads, angle) => {
+const sweep = (name, loads, angle, bench) => {
   const file = path.join(dataDir, '..', `${name}.json`);
   fs.writeFileSync(file, JSON.stringify({ name, window_s: 0.5, dimensions: { speed_rpm: [500, 900], load_Nm: loads, angle_deg: angle, configurations } }));
-  execFileSync(bin, ['sweep', file, '--db', path.join(dataDir, 'synbench.db')], { stdio: 'ignore' });
+  execFileSync(bin, ['sweep', file, '--db', path.join(dataDir, 'synbench.db'), '--bench-name', bench], { stdio: 'ignore' });
 };
-sweep('run A fine grid', [1, 2, 3], { from: 42, to: 66, step: 4 });   // sweep #1
-sweep('run B coarse grid', [0.5, 1, 2], { from: 44, to: 68, step: 6 }); // sweep #2
+sweep('run A fine grid', [1, 2, 3], { from: 42, to: 66, step: 4 }, 'bench-a');   // sweep #1
+sweep('run B coarse grid', [0.5, 1, 2], { from: 44, to: 68, step: 6 }, 'bench-b'); // sweep #2
 const daemon = await startDaemon(bin, dataDir, { webDir });
 const origin = await pageOrigin(daemon, webDir);
 const token = fs.readFileSync(path.join(dataDir, 'operator.token'), 'utf8').trim();
@@ -58,6 +60,32 @@ try {
   page.on('pageerror', (e) => pageErrors.push(e.message));
   await page.goto(origin.url);
   await signIn(page, token);
+
+  // ---- 0. runs of two benches in one store: History names, filters, compares ----
+  check(sweeps.find((s) => s.id === 1)?.bench?.name === 'bench-a' && sweeps.find((s) => s.id === 2)?.bench?.name === 'bench-b'
+    && sweeps.every((s) => s.bench.host && Array.isArray(s.bench.devices)), `REST names each sweep's bench (${JSON.stringify(sweeps.map((s) => s.bench))})`);
+  await page.goto(`${origin.url}#/history`);
+  const hist = () => page.$$eval('#history tbody tr', (trs) => trs.map((tr) => ({ id: Number(tr.dataset.id), bench: tr.querySelector('.bench')?.textContent.trim() })));
+  check(await until(async () => (await hist()).length === 2, 10000), 'History lists both runs');
+  const h2 = await hist();
+  check(h2.every((r) => r.bench.startsWith(r.id === 1 ? 'bench-a' : 'bench-b')), `each row names its bench (${JSON.stringify(h2)})`);
+  const benchOpts = await page.$$eval('#history-bench option', (os) => os.map((o) => o.value));
+  check(JSON.stringify(benchOpts) === JSON.stringify(['', 'bench-a', 'bench-b']), `the bench filter offers all, bench-a, bench-b (${benchOpts})`);
+  await page.selectOption('#history-bench', 'bench-b');
+  const hb = await hist();
+  check(hb.length === 1 && hb[0].id === 2, `filtered to bench-b: only sweep #2 (${JSON.stringify(hb)})`);
+  await page.selectOption('#history-bench', '');
+  check(await until(async () => (await hist()).length === 2, 5000), 'all benches again: both runs');
+  check(await page.$eval('#history-compare', (b) => b.disabled), 'Compare selected is disabled with nothing ticked');
+  await page.check('#history input[data-tick="2"]');
+  await page.check('#history input[data-tick="1"]');
+  const note = await text(page, '#history-compare-note');
+  check(!(await page.$eval('#history-compare', (b) => b.disabled)) && /#2 on bench-b.* against #1 on bench-a/.test(note), `two ticked runs of two benches: "${note}"`);
+  await page.click('#history-compare');
+  check(await until(async () => page.url().endsWith('#/results/1/vs/2') && (await rows(page, '#r-cmp-table')).length > 1, 15000),
+    'Compare selected opens #/results/1/vs/2 with the difference table');
+  const vsLabel = await page.$eval('#r-vs', (e) => e.selectedOptions[0]?.textContent || '');
+  check(/#2 run B coarse grid on bench-b/.test(vsLabel), `the comparison's run is named with its bench ("${vsLabel}")`);
 
   // ---- 1. compare two runs, from a link ----
   await page.goto(`${origin.url}#/results/1/vs/2`);
