@@ -112,6 +112,19 @@ TEST(Uncertainty, TypeAOfAMeanAllowsForALagOneCorrelationOfTheBatches) {
   EXPECT_FALSE(type_a_of_mean(std::vector<double>{}));
 }
 
+TEST(Uncertainty, TheRegroupingFitExtrapolatesVOfBToOneBatch) {
+  // {1, 3, 2, 4}: V(4) = (5/3) / 4 = 5/12; regrouped in 2 (means 2, 3): V(2) = 0.5 / 2 = 1/4.
+  // The line through them: b = (5/12 - 1/4) / 2 = 1/12, a = 1/4 - 2/12 = 1/12; u^2 = a + b = 1/6.
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 3, 2, 4}), std::sqrt(1.0 / 6.0), 1e-12);
+  // {1, 2, 3, 4}: regrouped means 1.5, 3.5, V(2) = 2 / 2 = 1 > V(4) = 5/12: b = -7/24 < 0, and
+  // a + b = 1 + 7/24 extrapolates upward (positively correlated batches).
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 2, 3, 4}), std::sqrt(1.0 + (1.0 - 5.0 / 12.0) / 2.0), 1e-12);
+  // Five batches (prime): no regrouping, s / sqrt(B).
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 3, 2, 4, 5}), *batch_standard_error(std::vector<double>{1, 3, 2, 4, 5}),
+              1e-15);
+  EXPECT_FALSE(regrouped_type_a(std::vector<double>{1.0}));
+}
+
 // Many windows of 10 batches: the RMS of the reported u against the true SD of the mean.
 struct Spread {
   double rms_u, rms_se, sd_u_rel;
