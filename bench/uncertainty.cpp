@@ -1,6 +1,7 @@
 // The point's uncertainty budget: its components and their propagation (GUM 5.1.2).
 #include "bench/uncertainty.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -47,7 +48,7 @@ void vfc_channel(std::vector<BudgetComponent>& comps, const char* ch, const driv
   const auto& counts = std::string(ch) == "M" ? m.batch_counts_m : m.batch_counts_g;
   const bool vfc = m.kf_Hz_per_A > 0 && m.gate_s > 0;
   std::vector<BudgetComponent> add;
-  auto a = type_a(std::string("I_dc") + ch + " type A", "batch means of the VFC sub-gates (GUM 4.2.3)", "A",
+  auto a = type_a(std::string("I_dc") + ch + " type A", "VFC sub-gates' means, lag-1 (MA(1)) model, GUM 4.2.3", "A",
                   vfc ? batch_currents_A(counts, m.gate_s, m.f0_Hz, m.kf_Hz_per_A) : std::vector<double>{},
                   vfc ? "the meter" : "the meter (no VFC calibration reported)");
   add.push_back(std::move(a));
@@ -76,7 +77,7 @@ void vfc_channel(std::vector<BudgetComponent>& comps, const char* ch, const driv
 
 }  // namespace
 
-std::optional<double> type_a_of_mean(std::span<const double> batch_means) {
+std::optional<double> batch_standard_error(std::span<const double> batch_means) {
   const std::size_t b = batch_means.size();
   if (b < 2) return std::nullopt;
   double mean = 0;
@@ -86,6 +87,75 @@ std::optional<double> type_a_of_mean(std::span<const double> batch_means) {
   for (double x : batch_means) ss += (x - mean) * (x - mean);
   const double s = std::sqrt(ss / static_cast<double>(b - 1));
   return s / std::sqrt(static_cast<double>(b));
+}
+
+std::optional<BatchTypeA> batch_type_a(std::span<const double> batch_means) {
+  const auto se = batch_standard_error(batch_means);
+  if (!se) return std::nullopt;
+  BatchTypeA r;
+  r.u = r.standard_error = *se;
+  const std::size_t n = batch_means.size();
+  // Below 4 batches the lag-1 sum carries no information beyond the lag-0 one (B = 2: it is
+  // exactly -Q0 / 2) or its estimate of gamma0 can turn negative (B = 3).
+  if (n < 4) return r;
+  const double B = static_cast<double>(n);
+  double mean = 0;
+  for (double x : batch_means) mean += x;
+  mean /= B;
+  double q0 = 0, q1 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double y = batch_means[k] - mean;
+    q0 += y * y;
+    if (k + 1 < n) q1 += y * (batch_means[k + 1] - mean);
+  }
+  // E[Q0] = a00 g0 + a01 g1 and E[Q1] = a10 g0 + a11 g1 for an MA(1) series with lag-0 and
+  // lag-1 autocovariances g0, g1: tr(C S) and tr(C M C S) with C the centring matrix, S the
+  // series' covariance and M the symmetric lag-1 pair matrix (docs/uncertainty.md).
+  const double a00 = B - 1, a01 = -2 * (B - 1) / B;
+  const double a10 = -(B - 1) / B, a11 = (B - 1) - 2 * (2 * B - 3) / B + 2 * (B - 1) * (B - 1) / (B * B);
+  const double det = a00 * a11 - a01 * a10;
+  // For B >= 4, |Q1| <= Q0 and a11 > |a01| keep g0 positive whenever Q0 is.
+  const double g0 = (a11 * q0 - a01 * q1) / det;
+  double g1 = (a00 * q1 - a10 * q0) / det;
+  if (!(g0 > 0)) return r;  // constant batches: u = 0 already
+  r.lag1 = true;
+  // sw^2 = tau (g0 + 2 g1) >= 0; g1 <= g0 / 2 keeps the MA(1) covariance positive definite.
+  g1 = std::clamp(g1, -g0 / 2, g0 / 2);
+  r.lag1_correlation = g1 / g0;
+  const double var = (g0 + 2 * g1) / B - 2 * g1 / (B * B);
+  // gamma1 > 0 is outside the stored-energy model (it gives gamma1 <= 0): positively correlated
+  // batches. The same MA(1) formula then inflates; never report less than s / sqrt(B) there.
+  r.u = g1 > 0 ? std::max(std::sqrt(var), *se) : std::sqrt(var);
+  return r;
+}
+
+std::optional<double> regrouped_type_a(std::span<const double> batch_means) {
+  const auto se = batch_standard_error(batch_means);
+  if (!se) return std::nullopt;
+  const std::size_t n = batch_means.size();
+  std::vector<double> g, v;
+  for (std::size_t groups = n; groups >= 2; --groups) {
+    if (n % groups) continue;
+    const std::size_t k = n / groups;
+    std::vector<double> m(groups, 0.0);
+    for (std::size_t i = 0; i < n; ++i) m[i / k] += batch_means[i] / static_cast<double>(k);
+    const double e = *batch_standard_error(m);
+    g.push_back(static_cast<double>(groups));
+    v.push_back(e * e);
+  }
+  if (g.size() < 2) return se;
+  const double cnt = static_cast<double>(g.size());
+  double sg = 0, sv = 0, sgg = 0, sgv = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) sg += g[i], sv += v[i], sgg += g[i] * g[i], sgv += g[i] * v[i];
+  const double b = (cnt * sgv - sg * sv) / (cnt * sgg - sg * sg), a = (sv - b * sg) / cnt;
+  if (a < 0) return std::sqrt(std::max(0.0, sgv / sgg));  // sw^2 >= 0: the fit through the origin
+  return std::sqrt(std::max(0.0, a + b));
+}
+
+std::optional<double> type_a_of_mean(std::span<const double> batch_means) {
+  const auto r = batch_type_a(batch_means);
+  if (!r) return std::nullopt;
+  return r->u;
 }
 
 std::vector<double> batch_currents_A(std::span<const std::uint64_t> batch_counts, double gate_s, double f0_Hz,
@@ -112,7 +182,7 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
       comps.push_back(std::move(c));
     }
     for (auto [name, out] : {std::tuple{"P_dcM type A", Output::pdcm_W}, std::tuple{"P_dcG type A", Output::pdcg_W}}) {
-      auto c = type_a(name, "batch means (GUM 4.2.3)", "W", {}, "the power meter");
+      auto c = type_a(name, "batch means, lag-1 (MA(1)) model, GUM 4.2.3", "W", {}, "the power meter");
       c.sensitivity[idx(out)] = 1.0;
       comps.push_back(std::move(c));
     }
@@ -134,7 +204,7 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
   const double c_T = w, c_n = (in.torque_Nm + 2.0 * in.load_b1_Nms_per_rad * w) * kRadPerRpm, c_b1 = w * w;
   {
     static const drivers::LoadWindow no_load;
-    auto c = type_a("T_L type A", "batch means of the load window (GUM 4.2.3)", "N m",
+    auto c = type_a("T_L type A", "load window's batch means, lag-1 (MA(1)) model, GUM 4.2.3", "N m",
                     (in.load ? *in.load : no_load).batch_torque_Nm, "the load drive");
     c.sensitivity[idx(Output::pm_W)] = c_T;
     comps.push_back(std::move(c));
@@ -148,7 +218,7 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
   static const drivers::SynrmWindow no_synrm;
   const drivers::SynrmWindow& sw = in.synrm ? *in.synrm : no_synrm;
   {
-    auto c = type_a("speed type A", "batch means of the SynRM window (GUM 4.2.3)", "rpm", sw.batch_speed_meas_rpm,
+    auto c = type_a("speed type A", "SynRM window's batch means, lag-1 (MA(1)) model, GUM 4.2.3", "rpm", sw.batch_speed_meas_rpm,
                     "the SynRM drive");
     c.sensitivity[idx(Output::pm_W)] = c_n;
     comps.push_back(std::move(c));
@@ -168,7 +238,7 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
   }
   // I_m.
   {
-    auto c = type_a("I_m type A", "batch means of the SynRM window (GUM 4.2.3)", "A", sw.batch_im_A, "the SynRM drive");
+    auto c = type_a("I_m type A", "SynRM window's batch means, lag-1 (MA(1)) model, GUM 4.2.3", "A", sw.batch_im_A, "the SynRM drive");
     c.sensitivity[idx(Output::im_A)] = 1.0;
     comps.push_back(std::move(c));
     auto g = type_b("I_m current sensor gain", "[assumed] SynRM drive's phase current sensors, %", "A",

@@ -19,8 +19,32 @@
 
 namespace synbench::bench {
 
-// Type A of a window's mean from its B batch means (GUM 4.2.3 with the batch means as the
-// independent observations): s(batch means) / sqrt(B); empty for B < 2.
+// The plain standard error of B batch means, s(batch means) / sqrt(B) (GUM 4.2.3 with the
+// batch means as independent observations); empty for B < 2.
+std::optional<double> batch_standard_error(std::span<const double> batch_means);
+
+// Type A of a window's mean from its B batch means, allowing for a lag-1 correlation between
+// consecutive batches (docs/uncertainty.md, "Type A"): the batch means taken as an MA(1) series
+// (white noise plus the difference of a bounded stored energy, (E_k - E_{k-1}) / tau), whose
+// mean has the variance (gamma0 + 2 gamma1) / B - 2 gamma1 / B^2. gamma0 and gamma1 are the
+// unbiased estimates under that model (the mean-centred lag-0 and lag-1 sums' expectations
+// solved for them), gamma1 clamped to [-gamma0 / 2, gamma0 / 2]; a positive gamma1 (positively
+// correlated batches) never gives less than s / sqrt(B). B = 2 or 3: s / sqrt(B) (too few
+// batches for a lag-1 estimate); B < 2: empty.
+struct BatchTypeA {
+  double u = 0;                // the type A of the window's mean
+  double standard_error = 0;   // s / sqrt(B), for comparison
+  double lag1_correlation = 0; // gamma1 / gamma0 after the clamp; 0 when not estimated
+  bool lag1 = false;           // the lag-1 model was applied (B >= 4)
+};
+std::optional<BatchTypeA> batch_type_a(std::span<const double> batch_means);
+// The alternative with the same model (docs/uncertainty.md, "Type A"): the window's batches
+// regrouped into G = every divisor of B from B down to 2 consecutive groups, V(G) = s_G^2 / G
+// fitted by least squares to a + b G, u^2 = a + b (G = 1, the window's mean); a < 0 refitted
+// through the origin (u^2 = b). b < 0 (V falling with longer batches: positively correlated
+// batches) extrapolates upward. Fewer than two such G (B prime, B < 4): s / sqrt(B).
+std::optional<double> regrouped_type_a(std::span<const double> batch_means);
+// batch_type_a(...).u: the estimator every type A component of the budget uses.
 std::optional<double> type_a_of_mean(std::span<const double> batch_means);
 
 // The currents of a VFC gate's equal sub-gates: I_b = (N_b / (T_g / B) - f0) / Kf.

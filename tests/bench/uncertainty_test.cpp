@@ -3,7 +3,11 @@
 // component is unavailable.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
 
 #include "bench/uncertainty.hpp"
 
@@ -64,14 +68,152 @@ struct Point {
   }
 };
 
-TEST(Uncertainty, TypeAOfAMeanIsTheBatchMeansStandardErrorAndNeedsTwo) {
+TEST(Uncertainty, TheBatchStandardErrorIsSOverSqrtBAndNeedsTwo) {
   // mean 2.5, s = sqrt(5/3), u = s / sqrt(4).
   const std::vector<double> x{1, 2, 3, 4};
-  ASSERT_TRUE(type_a_of_mean(x));
-  EXPECT_NEAR(*type_a_of_mean(x), std::sqrt(5.0 / 3.0) / 2.0, 1e-12);
-  EXPECT_DOUBLE_EQ(*type_a_of_mean(std::vector<double>{3, 3, 3}), 0.0);
+  ASSERT_TRUE(batch_standard_error(x));
+  EXPECT_NEAR(*batch_standard_error(x), std::sqrt(5.0 / 3.0) / 2.0, 1e-12);
+  EXPECT_FALSE(batch_standard_error(std::vector<double>{1.0}));
+}
+
+// The lag-1 estimator against values computed by hand (and by an independent script forming
+// E[Q0], E[Q1] as matrix traces): Q0 = sum (x - mean)^2, Q1 = sum of neighbours' products,
+// solved for gamma0, gamma1 of an MA(1) series, u^2 = (g0 + 2 g1) / B - 2 g1 / B^2.
+TEST(Uncertainty, TypeAOfAMeanAllowsForALagOneCorrelationOfTheBatches) {
+  // {1, 3, 2, 4}: Q0 = 5, Q1 = -1.75 -> g0 = 22/15, g1 = -0.4 (inside the clamp),
+  // u^2 = (22/15 - 0.8) / 4 + 0.8 / 16 = 13/60.
+  const auto a = batch_type_a(std::vector<double>{1, 3, 2, 4});
+  ASSERT_TRUE(a);
+  EXPECT_TRUE(a->lag1);
+  EXPECT_NEAR(a->u, std::sqrt(13.0 / 60.0), 1e-12);
+  EXPECT_NEAR(a->standard_error, std::sqrt(5.0 / 3.0) / 2.0, 1e-12);
+  EXPECT_NEAR(a->lag1_correlation, -0.4 / (22.0 / 15.0), 1e-12);
+  // {1, 2, 3, 4}: a trend, g1 = 2 > g0 / 2 = 4/3: clamped to g0 / 2, u^2 = g0 / B + g0 (B - 1) / B^2,
+  // 1.0801 against s / sqrt(B) = 0.6455: positively correlated batches inflate, never shrink.
+  const auto t = batch_type_a(std::vector<double>{1, 2, 3, 4});
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(t->u, std::sqrt(8.0 / 3.0 / 4.0 + 8.0 / 3.0 * 3.0 / 16.0), 1e-12);
+  EXPECT_NEAR(t->lag1_correlation, 0.5, 1e-12);
+  EXPECT_GT(t->u, t->standard_error);
+  // {1, -1, 1, -1, 1, -1}: alternating, g1 below -g0 / 2: clamped there (the white part zero),
+  // u = sqrt(g0) / B with g0 = 27/35: a pure difference series' mean.
+  const auto d = batch_type_a(std::vector<double>{1, -1, 1, -1, 1, -1});
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(d->u, std::sqrt(27.0 / 35.0) / 6.0, 1e-12);
+  EXPECT_NEAR(d->lag1_correlation, -0.5, 1e-12);
+  EXPECT_NEAR(*type_a_of_mean(std::vector<double>{1, -1, 1, -1, 1, -1}), d->u, 0.0);
+  // Three batches: too few for a lag-1 estimate, s / sqrt(B).
+  const auto three = batch_type_a(std::vector<double>{1, 3, 2});
+  ASSERT_TRUE(three);
+  EXPECT_FALSE(three->lag1);
+  EXPECT_NEAR(three->u, 1.0 / std::sqrt(3.0), 1e-12);
+  EXPECT_DOUBLE_EQ(*type_a_of_mean(std::vector<double>{3, 3, 3, 3, 3}), 0.0);
   EXPECT_FALSE(type_a_of_mean(std::vector<double>{1.0}));
   EXPECT_FALSE(type_a_of_mean(std::vector<double>{}));
+}
+
+TEST(Uncertainty, TheRegroupingFitExtrapolatesVOfBToOneBatch) {
+  // {1, 3, 2, 4}: V(4) = (5/3) / 4 = 5/12; regrouped in 2 (means 2, 3): V(2) = 0.5 / 2 = 1/4.
+  // The line through them: b = (5/12 - 1/4) / 2 = 1/12, a = 1/4 - 2/12 = 1/12; u^2 = a + b = 1/6.
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 3, 2, 4}), std::sqrt(1.0 / 6.0), 1e-12);
+  // {1, 2, 3, 4}: regrouped means 1.5, 3.5, V(2) = 2 / 2 = 1 > V(4) = 5/12: b = -7/24 < 0, and
+  // a + b = 1 + 7/24 extrapolates upward (positively correlated batches).
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 2, 3, 4}), std::sqrt(1.0 + (1.0 - 5.0 / 12.0) / 2.0), 1e-12);
+  // Five batches (prime): no regrouping, s / sqrt(B).
+  EXPECT_NEAR(*regrouped_type_a(std::vector<double>{1, 3, 2, 4, 5}), *batch_standard_error(std::vector<double>{1, 3, 2, 4, 5}),
+              1e-15);
+  EXPECT_FALSE(regrouped_type_a(std::vector<double>{1.0}));
+}
+
+// Many windows of 10 batches: the RMS of the reported u against the true SD of the mean.
+struct Spread {
+  double rms_u, rms_se, sd_u_rel;
+};
+template <class Gen>
+Spread over_windows(Gen&& window, int windows) {
+  double su2 = 0, sse2 = 0, su = 0;
+  for (int i = 0; i < windows; ++i) {
+    const std::vector<double> x = window();
+    const auto a = batch_type_a(x);
+    su2 += a->u * a->u;
+    su += a->u;
+    sse2 += a->standard_error * a->standard_error;
+  }
+  const double n = windows, mean_u = su / n, ms_u = su2 / n;
+  return {std::sqrt(ms_u), std::sqrt(sse2 / n), std::sqrt(std::max(0.0, ms_u - mean_u * mean_u)) / std::sqrt(ms_u)};
+}
+
+TEST(Uncertainty, WhiteBatchesGiveTheStandardErrorWithinNoise) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const auto s = over_windows(
+      [&] {
+        std::vector<double> x(10);
+        for (auto& v : x) v = e(rng);
+        return x;
+      },
+      20000);
+  // Truth 1 / sqrt(10); the estimator is unbiased in u^2 before its clamps, which lift it a
+  // little for white batches (a negative g1 is clamped only below -g0 / 2, a positive one
+  // never gives less than s / sqrt(B)).
+  std::printf("white: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u, s.rms_se,
+              1 / std::sqrt(10.0), s.sd_u_rel);
+  EXPECT_NEAR(s.rms_se * std::sqrt(10.0), 1.0, 0.02);
+  EXPECT_NEAR(s.rms_u * std::sqrt(10.0), 1.0, 0.10);
+}
+
+TEST(Uncertainty, ADifferenceSeriesGivesLessThanTwiceSOverB) {
+  // x_k = e_k - e_{k-1}: the mean is (e_B - e_0) / B, SD sqrt(2) / B, and s ~ sqrt(2): s / B,
+  // where s / sqrt(B) overstates by sqrt(B).
+  std::mt19937 rng(11);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const auto s = over_windows(
+      [&] {
+        std::vector<double> x(10);
+        double prev = e(rng);
+        for (auto& v : x) {
+          const double next = e(rng);
+          v = next - prev;
+          prev = next;
+        }
+        return x;
+      },
+      20000);
+  const double truth = std::sqrt(2.0) / 10;
+  std::printf("difference: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u, s.rms_se, truth,
+              s.sd_u_rel);
+  // The white part is zero here and its estimate, g0 + 2 g1, unbiased but noisy from 10 batches:
+  // clamped at zero it is left positive about half the time, so u is conservative by about
+  // 1.8 (measured) where the plain estimate overstates by sqrt(10); never optimistic.
+  EXPECT_GT(s.rms_u / truth, 1.0);
+  EXPECT_LT(s.rms_u / truth, 2.0);
+  EXPECT_GT(s.rms_se / truth, 3.0);  // the plain estimate: about sqrt(10) too large
+}
+
+TEST(Uncertainty, WhitePlusDifferenceComesCloseToTheMeansTrueSd) {
+  // The DC power's character: a white part and a larger difference part, sw^2 / tau = 1 and
+  // 2 vE / tau^2 = 18: the mean's variance 1 / 10 + 18 / 100 = 0.28, where s^2 / B is 1.9.
+  std::mt19937 rng(13);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const auto s = over_windows(
+      [&] {
+        std::vector<double> x(10);
+        double prev = 3 * e(rng);
+        for (auto& v : x) {
+          const double next = 3 * e(rng);
+          v = e(rng) + next - prev;
+          prev = next;
+        }
+        return x;
+      },
+      20000);
+  const double truth = std::sqrt(0.28);
+  std::printf("white + difference: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u,
+              s.rms_se, truth, s.sd_u_rel);
+  // As above, the zero-clamped noise of the white part's estimate: conservative by about 1.55.
+  EXPECT_GT(s.rms_u / truth, 1.0);
+  EXPECT_LT(s.rms_u / truth, 1.7);
+  EXPECT_GT(s.rms_se / truth, 2.5);
 }
 
 TEST(Uncertainty, BatchCountsBecomeTheSubGatesCurrents) {
@@ -120,12 +262,13 @@ TEST(Uncertainty, TheGateTimeEntersThroughF0OverKfPlusTheCurrent) {
 
 TEST(Uncertainty, TypeAComesFromTheBatchScatterAndPropagatesThroughUdc) {
   Point p;
-  // I_dcM batches 0.49, 0.51, 0.49, 0.51 A: s = 0.011547, u = s / 2.
+  // I_dcM batches 0.49, 0.51, 0.49, 0.51 A: alternating, the lag-1 clamp at -g0 / 2 gives
+  // u = sqrt(g0) / B with g0 = 8/15 x 0.01^2 (by hand as in the test above): 1.826 mA.
   p.m.batch_counts_m = {137250, 137750, 137250, 137750};
   const auto b = point_budget(p.in, zero_config());
   const auto& a = find(b, "I_dcM type A");
   ASSERT_TRUE(a.u);
-  const double u_a = std::sqrt(4 * 0.01 * 0.01 / 3.0) / 2.0;
+  const double u_a = 0.01 * std::sqrt(8.0 / 15.0) / 4.0;
   EXPECT_NEAR(*a.u, u_a, 1e-9);
   EXPECT_EQ(a.type, 'A');
   EXPECT_DOUBLE_EQ(a.sensitivity[static_cast<std::size_t>(Output::pdcm_W)], 420);
@@ -141,11 +284,11 @@ TEST(Uncertainty, ShaftPowerAndEfficiencyFromTorqueSpeedAndFriction) {
   auto cfg = zero_config();
   cfg.torque_gain_u_pct = 1.0;       // 0.025 N m
   cfg.load_b1_u_Nms_per_rad = 5e-5;  // x w^2
-  p.w.batch_speed_meas_rpm = {699, 701, 699, 701};  // u = 0.57735 rpm
+  p.w.batch_speed_meas_rpm = {699, 701, 699, 701};  // u = sqrt(8/15) / 4 = 0.18257 rpm
   const auto b = point_budget(p.in, cfg);
   const double wm = 700 * 2 * kPi / 60;
   const double u_T = 0.025 * wm, u_b1 = 5e-5 * wm * wm;
-  const double u_n = std::sqrt(4.0 / 3.0) / 2.0 * (2.5 + 2 * 2e-4 * wm) * 2 * kPi / 60;
+  const double u_n = std::sqrt(8.0 / 15.0) / 4.0 * (2.5 + 2 * 2e-4 * wm) * 2 * kPi / 60;
   ASSERT_TRUE(b.u(Output::pm_W));
   EXPECT_NEAR(*b.u(Output::pm_W), std::sqrt(u_T * u_T + u_b1 * u_b1 + u_n * u_n), 1e-9);
   EXPECT_NEAR(*b.u_repeat(Output::pm_W), u_n, 1e-9);  // gains and B1G are systematic
