@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "bench/analysis.hpp"
+#include "bench/sweep_outcome.hpp"
 #include "bench/pace.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
@@ -320,10 +321,16 @@ int sweep_command(const std::vector<std::string>& argv) {
     std::cerr << "synbench sweep: --export-json: cannot write '" << *json_out << "'\n";
     status = 1;
   }
+  std::map<std::size_t, bench::PointRecord> by_index;
+  for (const auto& r : *rows) by_index[static_cast<std::size_t>(r.index)] = r.record;
+  const auto outcome = bench::sweep_outcome(*plan, by_index);
+  if (!quiet) std::cerr << bench::to_text(outcome);
   if (analysis_out) {
     std::vector<bench::PointRecord> records;
     for (const auto& r : *rows) records.push_back(r.record);
-    if (!write_file(*analysis_out, bench::to_json(bench::analyze(records)).dump(1) + "\n")) {
+    auto analysis = bench::to_json(bench::analyze(records));
+    analysis["sweep_outcome"] = bench::to_json(outcome);
+    if (!write_file(*analysis_out, analysis.dump(1) + "\n")) {
       std::cerr << "synbench sweep: --analysis: cannot write '" << *analysis_out << "'\n";
       status = 1;
     }
