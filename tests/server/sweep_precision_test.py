@@ -9,7 +9,11 @@ from the far side (far_side.py reads the drives' registers straight from the emu
     longer window, its pdcm_u_repeat_W is at most the target; the events say it was measured
     again; `synbench sweep` prints the precision outcome; the drives end disabled;
  3. a target out of reach within a 0.6 s cap: the point is stored at 0.6 s with what it reached,
-    the event says the target was missed, and the analysis file's sweep_outcome counts it.
+    the event says the target was missed, and the analysis file's sweep_outcome counts it;
+ 4. an adaptive curve with `angle_u_target_deg: 0.5`: the angle setpoint register, polled from
+    the far side, takes every stored angle; the search stops before its cap with both angle u at
+    most 0.5 deg (and the analysis' own Monte Carlo on the same points agrees); the command prints
+    the points used against the 2-deg grid's, the analysis file carries the same in sweep_outcome.
 
 usage: sweep_precision_test.py path/to/synbench
 """
@@ -135,6 +139,57 @@ with tempfile.TemporaryDirectory(prefix="synbench-precision-") as tmp:
         outcome = json.load(open(analysis)).get("sweep_outcome", {}) if os.path.exists(analysis) else {}
         check((outcome.get("precision") or {}).get("points_missed") == 1 and outcome.get("adaptive") is None,
               "the analysis' sweep_outcome counts the missed point (%s)" % outcome)
+
+        # 4. An adaptive curve to an angle u target of 0.5 deg: the angle setpoints the drive was
+        # given (polled from the far side) are the stored points' angles; the search stops with
+        # both angle u below the target, and the analysis of the same points agrees.
+        plan = os.path.join(tmp, "adaptive.json")
+        with open(plan, "w") as f:
+            json.dump({"name": "adaptive until sure", "mode": "adaptive", "window_s": 0.5, "thermal": {"enabled": False},
+                       "dimensions": {"speed_rpm": [700], "load_Nm": [2.5]},
+                       "adaptive": {"angle_u_target_deg": 0.5, "max_evaluations": 12}}, f)
+        db = os.path.join(tmp, "adaptive.db")
+        pts = os.path.join(tmp, "adaptive_points.json")
+        analysis = os.path.join(tmp, "adaptive_analysis.json")
+        angles_seen = []
+        stop_watch = threading.Event()
+        watcher = fs.ModbusTcp(emu.port)
+
+        def watch_angles():
+            while not stop_watch.is_set():
+                a = round(watcher.angle_setpoint_deg(), 2)
+                if not angles_seen or angles_seen[-1] != a:
+                    angles_seen.append(a)
+                time.sleep(0.02)
+
+        t = threading.Thread(target=watch_angles, daemon=True)
+        t.start()
+        code, out, err = run("sweep", plan, "--bench", cfg, "--db", db, "--export-json", pts, "--analysis", analysis)
+        stop_watch.set()
+        t.join(timeout=5)
+        watcher.close()
+        stored = json.load(open(pts)) if os.path.exists(pts) else []
+        an = json.load(open(analysis)) if os.path.exists(analysis) else {}
+        ad = (an.get("sweep_outcome") or {}).get("adaptive") or {}
+        curve = (ad.get("curves") or [{}])[0]
+        print("     " + " ".join(line for line in err.splitlines() if line.startswith(("curve", "adaptive"))))
+        check(code == 0 and 4 <= len(stored) < 12, "adaptive sweep completes before its cap (%s, %d points; %s)"
+              % (code, len(stored), err.strip()[-300:]))
+        check("target met" in err and "adaptive: %d points used against 19 on the 2-deg grid" % len(stored) in err,
+              "sweep prints the curve's target met and the points used against the grid's")
+        check(curve.get("angle_u_target_met") is True and ad.get("points_used") == len(stored)
+              and ad.get("grid_points") == 19, "the analysis' sweep_outcome: target met, %s points of 19" % ad.get("points_used"))
+        mtpa_u, me_u = (curve.get("mtpa") or {}).get("angle_u_deg"), (curve.get("me") or {}).get("angle_u_deg")
+        check(mtpa_u is not None and me_u is not None and mtpa_u <= 0.5 and me_u <= 0.5,
+              "both angle u at most 0.5 deg (%s, %s)" % (mtpa_u, me_u))
+        ac = ((an.get("curves") or {}).get("entries") or [{}])[0]
+        check(ac.get("mtpa_angle_u_deg") is not None and ac["mtpa_angle_u_deg"] <= 0.5
+              and ac.get("me_angle_u_deg") is not None and ac["me_angle_u_deg"] <= 0.5,
+              "the analysis' own Monte Carlo on the same points: MTPA u %s, ME u %s deg"
+              % (ac.get("mtpa_angle_u_deg"), ac.get("me_angle_u_deg")))
+        want = sorted({round(p["angle_deg"], 2) for p in stored})
+        got = sorted({a for a in angles_seen if any(abs(a - w) < 0.011 for w in want)})
+        check(len(got) == len(want), "far side: the drive was commanded every stored angle (%s of %s)" % (got, want))
     finally:
         far.close()
         emu.stop()
