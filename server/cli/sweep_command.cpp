@@ -48,7 +48,10 @@ options:
   --bench FILE        bench config JSON (docs/bench-config.md): its drives instead of the twin
   --export-csv FILE   write the sweep's points as CSV when it ends
   --export-json FILE  write the sweep's points as JSON when it ends
-  --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
+  --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) and the
+                      sweep's outcome (adaptive searches, precision target) as JSON
+  --dry-run           check the plan and print its bench-time estimate as JSON (as
+                      POST /api/sweeps/estimate); nothing is measured or stored
   --quiet             no progress output
   --print-committed   print "committed INDEX" on stdout as each point's commit returns
   --help              this text
@@ -138,11 +141,11 @@ int sweep_command(const std::vector<std::string>& argv) {
   std::string db_path = "synbench.db";
   std::optional<std::int64_t> resume;
   std::optional<std::string> csv, json_out, analysis_out;
-  bool quiet = false, print_committed = false;
+  bool quiet = false, print_committed = false, dry_run = false;
   std::optional<LoadedBench> loaded;
   std::string bench_file;
   try {
-    Args a(argv, {"--quiet", "--print-committed", "--help"},
+    Args a(argv, {"--quiet", "--print-committed", "--dry-run", "--help"},
            {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
@@ -150,6 +153,7 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
     quiet = a.has("--quiet");
     print_committed = a.has("--print-committed");
+    dry_run = a.has("--dry-run");
     if (auto v = a.text("--db")) db_path = *v;
     csv = a.text("--export-csv");
     json_out = a.text("--export-json");
@@ -184,6 +188,15 @@ int sweep_command(const std::vector<std::string>& argv) {
   } catch (const emulator::ConfigError& e) {
     std::cerr << "synbench sweep: --config: " << e.what() << "\n";
     return 2;
+  }
+
+  if (dry_run) {
+    if (!plan) {
+      std::cerr << "synbench sweep: --dry-run: needs a plan file, not --resume\n";
+      return 2;
+    }
+    std::cout << bench::to_json(bench::estimate(*plan)).dump(1) << "\n";
+    return 0;
   }
 
   // A plan the bench's profiles cannot serve is refused before anything is stored (a resumed

@@ -2,6 +2,8 @@
 """"Measure until sure" over Modbus TCP: `synbench sweep --bench` on `synbench emulate`, judged
 from the far side (far_side.py reads the drives' registers straight from the emulator).
 
+ 0. `sweep --dry-run` with a precision section: the estimate is an upper bound including the
+    longer windows; a bad section is refused at its pointer;
  1. one point over a 0.3 s window without a target: its pdcm_u_repeat_W is u0;
  2. the same point with `precision: {pdcm_u_repeat_target_W: u0 / 1.6, max_window_s: 4}`: the
     SynRM drive's window_length_ms register (holding 2-3), polled from the far side while the
@@ -89,6 +91,18 @@ with tempfile.TemporaryDirectory(prefix="synbench-precision-") as tmp:
     far = fs.ModbusTcp(emu.port)
     cfg = fs.write_bench_config(os.path.join(tmp, "bench.json"), fs.tcp_link(emu.port))
     try:
+        # 0. The estimate, as `sweep --dry-run` prints it: an upper bound with the longer windows.
+        code, out, err = run("sweep", plan_file(tmp, "dry", {"pdcm_u_repeat_target_W": 0.05, "max_window_s": 4}),
+                             "--dry-run")
+        est = json.loads(out) if code == 0 and out.strip() else {}
+        check(est.get("upper_bound") is True and est.get("precision_extra_s", 0) >= 8
+              and est.get("bench_time_s", 0) > est.get("precision_extra_s", 0),
+              "sweep --dry-run: the estimate is an upper bound with the longer windows (%s; %s)" % (est, err.strip()))
+        code, out, err = run("sweep", plan_file(tmp, "dry_bad", {"pdcm_u_repeat_target_W": 0.05, "max_window_s": 0.1}),
+                             "--dry-run")
+        check(code == 2 and "/precision/max_window_s: must be at least the plan's window_s (0.3 s)" in err,
+              "sweep --dry-run refuses a bad precision section at its pointer (%s: %s)" % (code, err.strip()))
+
         # 1. u0 over 0.3 s.
         pts = os.path.join(tmp, "plain.json")
         code, out, err = run("sweep", plan_file(tmp, "plain"), "--bench", cfg, "--db", os.path.join(tmp, "plain.db"),
