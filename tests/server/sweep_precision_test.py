@@ -17,6 +17,9 @@ from the far side (far_side.py reads the drives' registers straight from the emu
     most 0.5 deg (and the analysis' own Monte Carlo on the same points agrees); the command prints
     the points used against the 2-deg grid's, the analysis file carries the same in sweep_outcome.
 
+The emulator's watchdog is 3 s, as in serve_bench_test.py: a loaded CI machine can stall the
+command line for a fraction of a second.
+
 usage: sweep_precision_test.py path/to/synbench
 """
 import json
@@ -87,7 +90,7 @@ def events(db):
 
 
 with tempfile.TemporaryDirectory(prefix="synbench-precision-") as tmp:
-    emu = fs.Emulator(BIN, os.path.join(tmp, "emulate.log"), args=["--duration-s", "600"])
+    emu = fs.Emulator(BIN, os.path.join(tmp, "emulate.log"), args=["--duration-s", "600", "--watchdog-timeout-ms", "3000"])
     far = fs.ModbusTcp(emu.port)
     cfg = fs.write_bench_config(os.path.join(tmp, "bench.json"), fs.tcp_link(emu.port))
     try:
