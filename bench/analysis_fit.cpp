@@ -8,9 +8,14 @@
 
 namespace synbench::bench {
 
-std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::span<const double> y) {
+namespace {
+
+// Both fits: unweighted with the residual variance (u empty), or weighted with known u.
+std::optional<QuadraticFit> fit_quadratic_impl(std::span<const double> x, std::span<const double> y,
+                                               std::span<const double> u) {
+  const bool weighted = !u.empty();
   const auto n = static_cast<Eigen::Index>(std::min(x.size(), y.size()));
-  if (n < 3) return std::nullopt;
+  if (n < 3 || (weighted && u.size() < static_cast<std::size_t>(n))) return std::nullopt;
   double mean = 0;
   for (Eigen::Index i = 0; i < n; ++i) mean += x[static_cast<std::size_t>(i)];
   mean /= static_cast<double>(n);
@@ -21,9 +26,13 @@ std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::spa
   Eigen::MatrixX3d phi(n, 3);
   Eigen::VectorXd rhs(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = (x[static_cast<std::size_t>(i)] - mean) / spread;
-    phi.row(i) << 1, t, t * t;
-    rhs(i) = y[static_cast<std::size_t>(i)];
+    const auto k = static_cast<std::size_t>(i);
+    const double t = (x[k] - mean) / spread;
+    // Weighted: each row divided by its u, so the ordinary solution is the weighted one.
+    const double w = weighted ? 1 / u[k] : 1.0;
+    if (!(w > 0) || !std::isfinite(w)) return std::nullopt;
+    phi.row(i) << w, w * t, w * t * t;
+    rhs(i) = w * y[k];
   }
   // QR of the design matrix, never the normal equations: their condition number is its square.
   const Eigen::ColPivHouseholderQR<Eigen::MatrixX3d> qr(phi);
@@ -34,8 +43,8 @@ std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::spa
   fit.q.c0 = b(0);
   fit.q.c1 = b(1) / spread;
   fit.q.c2 = b(2) / (spread * spread);
-  if (n > 3 && b(2) > 0) {
-    const double s2 = (phi * b - rhs).squaredNorm() / static_cast<double>(n - 3);
+  if ((weighted || n > 3) && b(2) > 0) {
+    const double s2 = weighted ? 1.0 : (phi * b - rhs).squaredNorm() / static_cast<double>(n - 3);
     // (Phi^T Phi)^-1 = P R^-1 R^-T P^T from the pivoted QR.
     const Eigen::Matrix3d r = qr.matrixR().topLeftCorner<3, 3>().triangularView<Eigen::Upper>();
     const Eigen::Matrix3d r_inv = r.triangularView<Eigen::Upper>().solve(Eigen::Matrix3d::Identity());
@@ -46,6 +55,18 @@ std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::spa
     fit.vertex_se = spread * std::sqrt(std::max(0.0, s2 * g.dot(cov * g)));
   }
   return fit;
+}
+
+}  // namespace
+
+std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::span<const double> y) {
+  return fit_quadratic_impl(x, y, {});
+}
+
+std::optional<QuadraticFit> fit_quadratic_weighted(std::span<const double> x, std::span<const double> y,
+                                                   std::span<const double> u) {
+  if (u.empty()) return std::nullopt;
+  return fit_quadratic_impl(x, y, u);
 }
 
 std::optional<Quadratic> fit_quadratic(std::span<const double> x, std::span<const double> y) {

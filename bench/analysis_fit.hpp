@@ -33,6 +33,13 @@ struct QuadraticFit {
 };
 std::optional<QuadraticFit> fit_quadratic_se(std::span<const double> x, std::span<const double> y);
 
+// Weighted least squares (weights 1 / u[i]^2) with the points' standard uncertainties u taken as
+// known: vertex_se is then the vertex's standard uncertainty from the fit's covariance
+// (Phi^T W Phi)^-1 by the delta method (GUM 5.1.2), also for three points, not scaled by the
+// residuals. Empty when a u is not > 0, as fit_quadratic_se otherwise.
+std::optional<QuadraticFit> fit_quadratic_weighted(std::span<const double> x, std::span<const double> y,
+                                                   std::span<const double> u);
+
 // The minimum of sampled values: the smallest sample, refined by the parabola through it and its
 // two neighbours when that parabola opens upward. `x` must be strictly increasing. A smallest
 // sample at either end is not refined (the true minimum may lie beyond it) and flagged.

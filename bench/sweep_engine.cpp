@@ -1,10 +1,12 @@
 // The sweep engine's state machine.
 #include "bench/sweep_engine.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "bench/pace.hpp"
+#include "bench/sweep_outcome.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -48,15 +50,7 @@ SweepEngine::SweepEngine(drivers::BenchDevices devices, const SafetySupervisor& 
   } else {
     // Replay what a previous run measured, so each search continues where it stopped.
     groups_ = plan_groups(plan_);
-    for (const auto& g : groups_) {
-      AngleSearch search(plan_.adaptive);
-      for (std::size_t e = 0; e < plan_.adaptive.max_evaluations; ++e) {
-        const auto it = stored_.find(g.group * plan_.adaptive.max_evaluations + e);
-        if (it == stored_.end()) break;
-        search.report(it->second.angle_deg, it->second.im_A, it->second.pdcm_W);
-      }
-      searches_.push_back(std::move(search));
-    }
+    for (const auto& g : groups_) searches_.push_back(replay_search(plan_, g, stored_));
   }
 }
 
@@ -102,10 +96,12 @@ std::optional<SweepEngine::Next> SweepEngine::next_point() {
   return std::nullopt;
 }
 
-void SweepEngine::start_point(const Next& n, double now_s) {
+void SweepEngine::start_point(const Next& n, double now_s, bool again) {
   current_ = n;
+  if (!again) remeasures_ = 0;
   PointOptions options = options_;
   options.gate.average_s = gate_average_s(plan_, config_of(n.point.request));
+  if (again) options.min_settle_s = 0;
   proc_ = std::make_unique<PointProcedure>(dev_, n.point.request, options);
   proc_->tick(now_s);
 }
@@ -124,6 +120,7 @@ void SweepEngine::finish_point(double /*now_s*/) {
     return;
   }
   const PointRecord& r = proc->record();
+  if (!proc->speed_lost() && measure_again(n, r)) return;
   if (const auto ec = sink_.store_point(n.point.index, r)) {
     error_ = "storing point " + std::to_string(n.point.index) + " failed: " + sink_.failure_message(ec);
     sink_.event("fault", error_);
@@ -133,7 +130,7 @@ void SweepEngine::finish_point(double /*now_s*/) {
   stored_[n.point.index] = r;
   ++measured_this_run_;
   running_config_ = config_of(n.point.request);
-  if (n.search) searches_[*n.search].report(r.angle_deg, r.im_A, r.pdcm_W);
+  if (n.search) searches_[*n.search].report(r.angle_deg, r.im_A, r.pdcm_W, r.im_u_repeat_A, r.pdcm_u_repeat_W);
   if (plan_.mode == SweepMode::grid) ++grid_pos_;
   sink_.progress(progress());
   if (r.lock_lost) {
@@ -165,6 +162,47 @@ void SweepEngine::finish_point(double /*now_s*/) {
     sink_.event("log", what);
     begin_stop(SweepState::running, now_, /*coast=*/true);
   }
+}
+
+bool SweepEngine::measure_again(const Next& n, const PointRecord& r) {
+  if (!plan_.precision) return false;
+  const PrecisionOptions& p = *plan_.precision;
+  const double window_s = n.point.request.window_s;
+  const auto u = r.pdcm_u_repeat_W;
+  if (u && *u <= p.pdcm_u_repeat_target_W) return false;
+  char what[300];
+  if (u && remeasures_ < kMaxPrecisionRemeasures && window_s < p.max_window_s) {
+    // Type A falls as window^-1/2 (batch means of a stationary signal): the window that reaches
+    // the target, with a fifth to spare for the estimate's own scatter, at least half as long
+    // again as this one, at most the cap; rounded up to the drive registers' 10 ms.
+    const double ratio = *u / p.pdcm_u_repeat_target_W;
+    const double predicted_s = 1.2 * window_s * ratio * ratio;
+    const double next_s =
+        std::min(p.max_window_s, std::ceil(std::max(predicted_s, 1.5 * window_s) * 100.0 - 1e-6) / 100.0);
+    std::snprintf(what, sizeof what,
+                  "point %zu: pdcm_u_repeat_W %.3g W above the target %.3g W over %.3g s; measuring again over "
+                  "%.3g s",
+                  static_cast<std::size_t>(n.point.index), *u, p.pdcm_u_repeat_target_W, window_s, next_s);
+    sink_.event("log", what);
+    Next again = n;
+    again.point.request.window_s = next_s;
+    ++remeasures_;
+    start_point(again, now_, /*again=*/true);
+    return true;
+  }
+  if (u) {
+    std::snprintf(what, sizeof what,
+                  "point %zu: precision target missed: pdcm_u_repeat_W %.3g W above the target %.3g W over "
+                  "%.3g s (max_window_s %.3g s); stored as reached",
+                  static_cast<std::size_t>(n.point.index), *u, p.pdcm_u_repeat_target_W, window_s, p.max_window_s);
+  } else {
+    std::snprintf(what, sizeof what,
+                  "point %zu: precision target missed: no pdcm_u_repeat_W (no uncertainty budget); stored as "
+                  "measured",
+                  static_cast<std::size_t>(n.point.index));
+  }
+  sink_.event("log", what);
+  return false;
 }
 
 void SweepEngine::begin_stop(SweepState final_state, double now_s, bool coast) {

@@ -87,7 +87,12 @@ class SweepEngine {
     std::optional<std::size_t> search;  // the adaptive search it belongs to
   };
   std::optional<Next> next_point();
-  void start_point(const Next& n, double now_s);
+  // `again`: the same point measured once more on the running bench (a precision target):
+  // no least settling time, the gate alone decides.
+  void start_point(const Next& n, double now_s, bool again = false);
+  // A precision target the record misses: true when the point is being measured again (a longer
+  // window); false when it is to be stored as it is (flagged when it missed the target).
+  bool measure_again(const Next& n, const PointRecord& r);
   void finish_point(double now_s);
   // `coast`: once the load torque is gone, disable at once instead of commanding zero speed (a
   // drive that lost the rotor cannot be trusted to decelerate it).
@@ -119,6 +124,7 @@ class SweepEngine {
   OrderedStop stop_;
   double t0_ = -1, now_ = 0;
   std::size_t measured_this_run_ = 0;
+  std::size_t remeasures_ = 0;  // windows after the first of the point under way
   std::string error_;
 };
 

@@ -138,6 +138,7 @@ std::string_view name(SweepDimension d) {
 }
 
 std::string_view name(SweepMode m) { return kSweepModeNames[static_cast<std::size_t>(m)]; }
+std::string_view name(PrecisionMode m) { return kPrecisionModeNames[static_cast<std::size_t>(m)]; }
 
 std::string order_name(const std::array<SweepDimension, 4>& order) {
   std::string s;
@@ -247,7 +248,8 @@ ojson to_json(const SweepPlan& p) {
                      {"tolerance_deg", a.tolerance_deg},
                      {"max_evaluations", a.max_evaluations},
                      {"stencil_deg", a.stencil_deg},
-                     {"resolution_deg", a.resolution_deg}};
+                     {"resolution_deg", a.resolution_deg},
+                     {"angle_u_target_deg", a.angle_u_target_deg ? ojson(*a.angle_u_target_deg) : ojson(nullptr)}};
   }
   const auto& g = p.gate;
   j["gate"] = {{"span_s", g.bands.span_s},
@@ -260,6 +262,11 @@ ojson to_json(const SweepPlan& p) {
                {"min_settle_s", g.min_settle_s},
                {"timeout_s", g.timeout_s}};
   j["window_s"] = p.window_s;
+  if (p.precision) {
+    j["precision"] = {{"pdcm_u_repeat_target_W", p.precision->pdcm_u_repeat_target_W},
+                      {"max_window_s", p.precision->max_window_s},
+                      {"mode", std::string(name(p.precision->mode))}};
+  }
   const auto& t = p.thermal;
   j["thermal"] = {{"enabled", t.enabled},
                   {"target_C", t.target_C},
@@ -322,12 +329,19 @@ SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& m) {
     else if (speed_ramp_s > 0 || load_ramp_s > 0) t += std::max(speed_ramp_s, load_ramp_s) + m.ramp_settle_s;
     else t += m.angle_settle_s;
     t += per_point_s(s.config);
+    if (plan.precision) {
+      // Measured again on the running bench: the gate's span, then a window of at most the cap.
+      const double again_s = plan.gate.bands.span_s + gate_average_s(plan, s.config) +
+                             plan.precision->max_window_s + m.point_overhead_s;
+      e.precision_extra_s += static_cast<double>(kMaxPrecisionRemeasures) * again_s;
+    }
     speed = s.speed_rpm;
     load = s.load_Nm;
     standstill = false;
   }
   if (!steps.empty()) t += ordered_stop_s(speed, load);  // back to standstill at the end
-  e.bench_time_s = t;
+  e.bench_time_s = t + e.precision_extra_s;
+  if (plan.precision) e.upper_bound = true;
   return e;
 }
 
@@ -340,6 +354,7 @@ ojson to_json(const SweepEstimate& e) {
   j["load_changes"] = e.load_changes;
   j["configuration_changes"] = e.configuration_changes;
   j["bench_time_s"] = e.bench_time_s;
+  j["precision_extra_s"] = e.precision_extra_s;
   return j;
 }
 

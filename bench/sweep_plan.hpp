@@ -81,6 +81,24 @@ struct SweepLimits {
   bool operator==(const SweepLimits&) const = default;
 };
 
+// "Measure until sure" (docs/sweep-plan.md, "Precision"): a point whose pdcm_u_repeat_W (the
+// point-to-point part of P_dcM's standard uncertainty, which limits comparing the points of one
+// curve; the systematic rest is common to them and no window length reduces it) is above the
+// target is measured again, drives kept running, over a longer window predicted from
+// u ~ window^-1/2 and capped at max_window_s; only the last record is stored, at the point's
+// own index. A point that cannot reach the target within the cap is stored with what it reached
+// and flagged (an event, a count in the sweep's outcome).
+enum class PrecisionMode { lengthen };
+inline constexpr std::array<std::string_view, 1> kPrecisionModeNames{"lengthen"};  // by value
+struct PrecisionOptions {
+  double pdcm_u_repeat_target_W = 0.05;
+  double max_window_s = 8.0;
+  PrecisionMode mode = PrecisionMode::lengthen;
+  bool operator==(const PrecisionOptions&) const = default;
+};
+// At most this many windows after the first: the predicted one, then the cap.
+inline constexpr std::size_t kMaxPrecisionRemeasures = 2;
+
 inline constexpr std::array<SweepDimension, 4> kDefaultOrder{SweepDimension::speed, SweepDimension::load,
                                                              SweepDimension::config, SweepDimension::angle};
 
@@ -97,6 +115,7 @@ struct SweepPlan {
   AngleSearchOptions adaptive;  // used in adaptive mode
   GateOptions gate;
   double window_s = 1.0;
+  std::optional<PrecisionOptions> precision;  // none: every point measured once over window_s
   ThermalOptions thermal;
   SweepLimits limits;
   std::vector<std::string> notes;  // how the plan was built, e.g. how a preset treats a point
@@ -188,7 +207,10 @@ struct SweepEstimate {
   std::size_t load_changes = 0;
   std::size_t configuration_changes = 0;
   double bench_time_s = 0;
-  bool upper_bound = false;      // true in adaptive mode
+  bool upper_bound = false;      // true in adaptive mode and with a precision target
+  // With a precision target: the bench time the longer windows may add at most (included in
+  // bench_time_s: every point measured kMaxPrecisionRemeasures more times, over max_window_s).
+  double precision_extra_s = 0;
 };
 
 SweepEstimate estimate(const SweepPlan& plan, const SweepTimeModel& model = {});
@@ -201,6 +223,7 @@ std::vector<double> inclusive_range(double from, double to, double step);
 
 std::string_view name(SweepDimension d);
 std::string_view name(SweepMode m);
+std::string_view name(PrecisionMode m);
 // "speed-load-config-angle"
 std::string order_name(const std::array<SweepDimension, 4>& order);
 

@@ -35,8 +35,9 @@ double AngleSearch::distance_to_points(double angle_deg) const {
   return d;
 }
 
-void AngleSearch::report(double angle_deg, double im_A, double pdcm_W) {
-  points_.push_back({angle_deg, im_A, pdcm_W});
+void AngleSearch::report(double angle_deg, double im_A, double pdcm_W, std::optional<double> im_u_A,
+                         std::optional<double> pdcm_u_W) {
+  points_.push_back({angle_deg, im_A, pdcm_W, im_u_A, pdcm_u_W});
   if (!golden_) return;
   const double same = std::max(opt_.resolution_deg, 1e-9) / 2;
   if (!f1_ && std::fabs(angle_deg - x1_) <= same) {
@@ -73,6 +74,7 @@ void AngleSearch::report(double angle_deg, double im_A, double pdcm_W) {
 
 AngleOptimum AngleSearch::fit_in_window(Objective k, double window_deg) const {
   auto value = [](const AngleSearchEvaluation& p, Objective o) { return o == im ? p.im_A : p.pdcm_W; };
+  auto u_of = [](const AngleSearchEvaluation& p, Objective o) { return o == im ? p.im_u_A : p.pdcm_u_W; };
   AngleOptimum out;
   if (points_.empty()) {
     out.angle_deg = round((opt_.from_deg + opt_.to_deg) / 2);
@@ -93,20 +95,29 @@ AngleOptimum AngleSearch::fit_in_window(Objective k, double window_deg) const {
   // Fit over a window around the best point, then once more around the vertex found: the second
   // pass centres the window on the minimum when the best point sits on one side of it.
   double centre = best->angle_deg;
-  std::vector<double> xs, ys, other;
+  std::vector<double> xs, ys, us, other;
   std::optional<QuadraticFit> f;
+  bool weighted = false;
   double vertex = centre;
   for (int pass = 0; pass < 2; ++pass) {
     xs.clear();
     ys.clear();
+    us.clear();
     other.clear();
+    // Only with a target: without one the search keeps its residual-based fits (and proposals).
+    weighted = opt_.angle_u_target_deg.has_value();
     for (const auto& p : points_) {
       if (std::fabs(p.angle_deg - centre) > window_deg) continue;
       xs.push_back(p.angle_deg);
       ys.push_back(value(p, k));
+      const auto u = u_of(p, k);
+      weighted = weighted && u && *u > 0;
+      us.push_back(u.value_or(0.0));
       other.push_back(value(p, k == im ? pdcm : im));
     }
-    f = fit_quadratic_se(xs, ys);
+    // Points with their u: weighted by them (a lengthened window counts for more), and the
+    // vertex's uncertainty from them; else ordinary least squares.
+    f = weighted ? fit_quadratic_weighted(xs, ys, us) : fit_quadratic_se(xs, ys);
     if (!f || f->q.c2 <= 0) return out;
     const auto [lo, hi] = std::minmax_element(xs.begin(), xs.end());
     vertex = std::clamp(f->q.vertex(), *lo, *hi);
@@ -115,7 +126,13 @@ AngleOptimum AngleSearch::fit_in_window(Objective k, double window_deg) const {
   out.angle_deg = vertex;
   out.refined = true;
   out.points_used = xs.size();
-  out.angle_se_deg = f->vertex_se;
+  if (weighted) {
+    out.angle_u_deg = f->vertex_se;
+    // The residual-based standard error as well, for the tolerance rule.
+    if (const auto plain = fit_quadratic_se(xs, ys)) out.angle_se_deg = plain->vertex_se;
+  } else {
+    out.angle_se_deg = f->vertex_se;
+  }
   out.at_edge = out.at_edge || at_bracket_end(vertex);
   // The other quantity from its own parabola over the same points (three distinct angles at
   // least, or the first fit would have failed).
@@ -127,13 +144,16 @@ AngleOptimum AngleSearch::fit_in_window(Objective k, double window_deg) const {
 }
 
 AngleOptimum AngleSearch::fit(Objective k) const {
-  const double se_inf = INFINITY;
+  // How well a fit fixes its vertex: from the points' u where known, else from its residuals.
+  const auto spread = [](const AngleOptimum& o) {
+    return o.angle_u_deg ? *o.angle_u_deg : o.angle_se_deg.value_or(INFINITY);
+  };
   const AngleOptimum narrow = fit_in_window(k, 1.5 * opt_.stencil_deg);
   // A flat or noisy curve can leave the narrow window's vertex ill determined; a wider window
   // brings in more points (at some bias from the curve's asymmetry), used when it does better.
-  if (narrow.refined && narrow.angle_se_deg.value_or(se_inf) <= opt_.stencil_deg / 3) return narrow;
+  if (narrow.refined && spread(narrow) <= opt_.stencil_deg / 3) return narrow;
   const AngleOptimum wide = fit_in_window(k, 2.5 * opt_.stencil_deg);
-  if (wide.refined && wide.angle_se_deg.value_or(se_inf) < narrow.angle_se_deg.value_or(se_inf)) return wide;
+  if (wide.refined && spread(wide) < spread(narrow)) return wide;
   return narrow;
 }
 
@@ -172,7 +192,10 @@ std::optional<double> AngleSearch::next_angle() const {
     }
     return pick;
   };
+  // With a target, the stencil is only a means: stop as soon as both angles are known well enough.
+  if (opt_.angle_u_target_deg && target_met(mtpa) && target_met(me)) return std::nullopt;
   if (auto pick = farthest(false)) return pick;
+  if (opt_.angle_u_target_deg) return toward_target(mtpa, me);
 
   // The stencil is complete. Stop when both vertices are determined to half the tolerance;
   // otherwise (noise) spend the remaining budget around the optima.
@@ -201,8 +224,43 @@ std::optional<double> AngleSearch::next_angle() const {
   return round(mid);
 }
 
+bool AngleSearch::target_met(const AngleOptimum& o) const {
+  // A vertex on the bracket's edge may lie beyond it: its u says nothing about the optimum. Three
+  // points in the window fit the parabola exactly, with nothing to show it is one.
+  return opt_.angle_u_target_deg && o.refined && !o.at_edge && o.points_used >= 4 && o.angle_u_deg &&
+         *o.angle_u_deg <= *opt_.angle_u_target_deg;
+}
+
+std::optional<double> AngleSearch::toward_target(const AngleOptimum& mtpa, const AngleOptimum& me) const {
+  const bool mtpa_met = target_met(mtpa), me_met = target_met(me);
+  if (mtpa_met && me_met) return std::nullopt;
+  // A vertex's uncertainty falls most with points far out on both flanks (they fix the slope
+  // and the curvature) and some at the vertex: the stencil's ends and the vertex, taking in turn
+  // the one with the fewest points within the tolerance (the first in this order on a tie).
+  std::vector<double> candidates;
+  for (const AngleOptimum* o : {&mtpa, &me}) {
+    if (target_met(*o)) continue;
+    candidates.push_back(round(clamp(o->angle_deg - opt_.stencil_deg)));
+    candidates.push_back(round(clamp(o->angle_deg + opt_.stencil_deg)));
+    candidates.push_back(round(clamp(o->angle_deg)));
+  }
+  std::optional<double> pick;
+  std::size_t fewest = 0;
+  for (const double c : candidates) {
+    std::size_t near = 0;
+    for (const auto& p : points_) near += std::fabs(p.angle_deg - c) < opt_.tolerance_deg;
+    if (!pick || near < fewest) {
+      pick = c;
+      fewest = near;
+    }
+  }
+  return pick;
+}
+
 AngleSearchResult AngleSearch::result() const {
-  return {fit(im), fit(pdcm), points_.size()};
+  AngleSearchResult r{fit(im), fit(pdcm), points_.size(), false};
+  r.angle_u_target_met = target_met(r.mtpa) && target_met(r.me);
+  return r;
 }
 
 }  // namespace synbench::bench

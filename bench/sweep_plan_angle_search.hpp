@@ -14,7 +14,10 @@
 //     is better determined); one more point at the vertex (or between both vertices when they are
 //     close) if none is within tolerance_deg;
 //  4. while the residuals say a vertex is uncertain by more than half the tolerance (noise),
-//     more points around the optima, up to max_evaluations.
+//     more points around the optima, up to max_evaluations;
+//     with angle_u_target_deg instead: while either angle's standard uncertainty, from the
+//     points' reported u through the weighted fit, is above the target, more points at the
+//     optimum's stencil ends and vertex (where it has the fewest), up to max_evaluations.
 // Fitting a parabola over a wide stencil averages measurement noise, which comparing nearby
 // points (as golden section alone does) cannot: near the minimum I_m changes by only ~0.03 %
 // per degree squared.
@@ -37,11 +40,18 @@ struct AngleSearchOptions {
   double stencil_deg = 6.0;          // half width of the fitting stencil around each optimum
   std::size_t max_evaluations = 7;   // hard cap per curve
   double resolution_deg = 0.01;      // proposals are rounded to this (the drive register's step)
+  // "Measure until sure": keep adding points near the optima until the standard uncertainty of
+  // both the MTPA and the ME angle (from the weighted fit, the points' reported u) is at most
+  // this, or max_evaluations is reached. None: stop on tolerance_deg as before.
+  std::optional<double> angle_u_target_deg;
   bool operator==(const AngleSearchOptions&) const = default;
 };
 
 struct AngleSearchEvaluation {
   double angle_deg = 0, im_A = 0, pdcm_W = 0;
+  // The point's standard uncertainties, their point-to-point parts (the record's im_u_repeat_A,
+  // pdcm_u_repeat_W): what scatters between the points of one curve. Empty: not known.
+  std::optional<double> im_u_A, pdcm_u_W;
 };
 
 // One optimum with both quantities read there from the fitted parabolas.
@@ -54,12 +64,18 @@ struct AngleOptimum {
   std::size_t points_used = 0;   // points inside the fitting window
   std::optional<double> angle_se_deg;  // standard error of angle_deg from the fit's residuals;
                                        // unknown with only three points in the window
+  // Standard uncertainty of angle_deg from the points' reported u (weighted fit, its covariance
+  // by the delta method); known with angle_u_target_deg set and every point in the window
+  // reported with its u. The parabola is then the weighted one, and angle_deg its vertex.
+  std::optional<double> angle_u_deg;
 };
 
 struct AngleSearchResult {
   AngleOptimum mtpa;  // minimum of im_A
   AngleOptimum me;    // minimum of pdcm_W
   std::size_t evaluations = 0;
+  // Both angles' angle_u_deg known and at most options' angle_u_target_deg (false without one).
+  bool angle_u_target_met = false;
 };
 
 class AngleSearch {
@@ -68,8 +84,10 @@ class AngleSearch {
 
   // The next angle to measure, or nothing when the search is finished (or the cap is reached).
   std::optional<double> next_angle() const;
-  // The measured values at `angle_deg` (normally the angle next_angle() proposed).
-  void report(double angle_deg, double im_A, double pdcm_W);
+  // The measured values at `angle_deg` (normally the angle next_angle() proposed), with their
+  // point-to-point standard uncertainties when known (needed for angle_u_target_deg).
+  void report(double angle_deg, double im_A, double pdcm_W, std::optional<double> im_u_A = std::nullopt,
+              std::optional<double> pdcm_u_W = std::nullopt);
 
   bool finished() const { return !next_angle(); }
   const std::vector<AngleSearchEvaluation>& evaluations() const { return points_; }
@@ -84,6 +102,9 @@ class AngleSearch {
   double distance_to_points(double angle_deg) const;
   AngleOptimum fit(Objective k) const;
   AngleOptimum fit_in_window(Objective k, double window_deg) const;
+  bool target_met(const AngleOptimum& o) const;
+  // With angle_u_target_deg: the next point for the optima whose angle u is above the target.
+  std::optional<double> toward_target(const AngleOptimum& mtpa, const AngleOptimum& me) const;
 
   AngleSearchOptions opt_;
   std::vector<AngleSearchEvaluation> points_;

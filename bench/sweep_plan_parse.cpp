@@ -307,7 +307,8 @@ void parse_dimensions(const JsonNode& d, SweepPlan& plan, bool has_preset) {
 
 void parse_adaptive(const JsonNode& v, AngleSearchOptions& a) {
   if (!v.object()) return;
-  v.reject_unknown({"bracket_deg", "tolerance_deg", "max_evaluations", "stencil_deg", "resolution_deg"});
+  v.reject_unknown({"bracket_deg", "tolerance_deg", "max_evaluations", "stencil_deg", "resolution_deg",
+                    "angle_u_target_deg"});
   if (const JsonNode b = v["bracket_deg"]; b.present()) {
     if (!b.json().is_array() || b.json().size() != 2) {
       b.fail("must be [from, to]");
@@ -327,8 +328,30 @@ void parse_adaptive(const JsonNode& v, AngleSearchOptions& a) {
   set(v["tolerance_deg"], a.tolerance_deg, above_at_most(0, 10, "deg"));
   set(v["stencil_deg"], a.stencil_deg, above_at_most(0, 45, "deg"));
   set(v["resolution_deg"], a.resolution_deg, above_at_most(0, 1, "deg"));
+  set_or_clear(v["angle_u_target_deg"], a.angle_u_target_deg, above_at_most(0, 45, "deg"));
   // Golden section needs two points and a parabola three.
   if (auto m = v["max_evaluations"].integer(3, 100)) a.max_evaluations = static_cast<std::size_t>(*m);
+}
+
+// "precision": {"pdcm_u_repeat_target_W": 0.05, "max_window_s": 8, "mode": "lengthen"}; null
+// (or absent) measures every point once.
+void parse_precision(const JsonNode& v, const SweepPlan& plan, std::optional<PrecisionOptions>& out) {
+  if (!v.present()) return;
+  if (v.is_null()) {
+    out.reset();
+    return;
+  }
+  if (!v.object()) return;
+  v.reject_unknown({"pdcm_u_repeat_target_W", "max_window_s", "mode"});
+  PrecisionOptions p = out.value_or(PrecisionOptions{});
+  if (!v.has("pdcm_u_repeat_target_W") && !out)
+    v["pdcm_u_repeat_target_W"].fail("required field is missing");
+  set(v["pdcm_u_repeat_target_W"], p.pdcm_u_repeat_target_W, above_at_most(0, 1000, "W"));
+  set(v["max_window_s"], p.max_window_s, above_at_most(0, 3600, "s"));
+  if (auto m = v["mode"].choice<PrecisionMode>(kPrecisionModeNames, "precision mode")) p.mode = *m;
+  if (p.max_window_s < plan.window_s)
+    v["max_window_s"].fail("must be at least the plan's window_s (" + num(plan.window_s) + " s)");
+  out = p;
 }
 
 void parse_gate(const JsonNode& v, GateOptions& g) {
@@ -456,8 +479,8 @@ SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
     result.errors = std::move(r.errors);
     return result;
   }
-  root.reject_unknown({"name", "preset", "dimensions", "order", "mode", "adaptive", "gate", "window_s", "thermal",
-                       "limits", "notes"});
+  root.reject_unknown({"name", "preset", "dimensions", "order", "mode", "adaptive", "gate", "window_s", "precision",
+                       "thermal", "limits", "notes"});
 
   const bool has_preset = root.has("preset");
   SweepPlan plan = has_preset ? preset_plan(root["preset"]) : SweepPlan{};
@@ -500,6 +523,7 @@ SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
   parse_adaptive(root["adaptive"], plan.adaptive);
   parse_gate(root["gate"], plan.gate);
   set(root["window_s"], plan.window_s, above_at_most(0, 3600, "s"));
+  parse_precision(root["precision"], plan, plan.precision);
   parse_thermal(root["thermal"], plan.thermal, plan.limits);
   if (auto notes = root["notes"].texts()) plan.notes = *notes;
 

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "bench/analysis.hpp"
+#include "bench/sweep_outcome.hpp"
 #include "bench/pace.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
@@ -51,7 +52,10 @@ options:
                       profiles' versions (default: the host name; docs/database.md)
   --export-csv FILE   write the sweep's points as CSV when it ends
   --export-json FILE  write the sweep's points as JSON when it ends
-  --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) as JSON
+  --analysis FILE     write the analysis (MTPA/ME angles, deltas, histograms, efficiency map) and the
+                      sweep's outcome (adaptive searches, precision target) as JSON
+  --dry-run           check the plan and print its bench-time estimate as JSON (as
+                      POST /api/sweeps/estimate); nothing is measured or stored
   --quiet             no progress output
   --print-committed   print "committed INDEX" on stdout as each point's commit returns
   --help              this text
@@ -141,12 +145,12 @@ int sweep_command(const std::vector<std::string>& argv) {
   std::string db_path = "synbench.db";
   std::optional<std::int64_t> resume;
   std::optional<std::string> csv, json_out, analysis_out;
-  bool quiet = false, print_committed = false;
+  bool quiet = false, print_committed = false, dry_run = false;
   std::optional<LoadedBench> loaded;
   std::string bench_file;
   std::string bench_name;
   try {
-    Args a(argv, {"--quiet", "--print-committed", "--help"},
+    Args a(argv, {"--quiet", "--print-committed", "--dry-run", "--help"},
            {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis", "--bench-name"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
@@ -154,6 +158,7 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
     quiet = a.has("--quiet");
     print_committed = a.has("--print-committed");
+    dry_run = a.has("--dry-run");
     if (auto v = a.text("--db")) db_path = *v;
     if (auto v = a.text("--bench-name")) bench_name = *v;
     csv = a.text("--export-csv");
@@ -189,6 +194,15 @@ int sweep_command(const std::vector<std::string>& argv) {
   } catch (const emulator::ConfigError& e) {
     std::cerr << "synbench sweep: --config: " << e.what() << "\n";
     return 2;
+  }
+
+  if (dry_run) {
+    if (!plan) {
+      std::cerr << "synbench sweep: --dry-run: needs a plan file, not --resume\n";
+      return 2;
+    }
+    std::cout << bench::to_json(bench::estimate(*plan)).dump(1) << "\n";
+    return 0;
   }
 
   // A plan the bench's profiles cannot serve is refused before anything is stored (a resumed
@@ -327,10 +341,16 @@ int sweep_command(const std::vector<std::string>& argv) {
     std::cerr << "synbench sweep: --export-json: cannot write '" << *json_out << "'\n";
     status = 1;
   }
+  std::map<std::size_t, bench::PointRecord> by_index;
+  for (const auto& r : *rows) by_index[static_cast<std::size_t>(r.index)] = r.record;
+  const auto outcome = bench::sweep_outcome(*plan, by_index);
+  if (!quiet) std::cerr << bench::to_text(outcome);
   if (analysis_out) {
     std::vector<bench::PointRecord> records;
     for (const auto& r : *rows) records.push_back(r.record);
-    if (!write_file(*analysis_out, bench::to_json(bench::analyze(records)).dump(1) + "\n")) {
+    auto analysis = bench::to_json(bench::analyze(records));
+    analysis["sweep_outcome"] = bench::to_json(outcome);
+    if (!write_file(*analysis_out, analysis.dump(1) + "\n")) {
       std::cerr << "synbench sweep: --analysis: cannot write '" << *analysis_out << "'\n";
       status = 1;
     }

@@ -213,6 +213,37 @@ synbench::Json efficiency_map_schema() {
                                  {"cells", {{"type", "array"}, {"items", cell}}}}));
 }
 
+// bench::to_json(SweepOutcome): what an adaptive search and a precision target used and reached.
+synbench::Json sweep_outcome_schema() {
+  const synbench::Json optimum = closed_object({{"angle_deg", kNum},
+                                                {"angle_u_deg", nullable(kNum)},
+                                                {"refined", kBool},
+                                                {"at_edge", kBool},
+                                                {"points_in_fit", kInt}});
+  const synbench::Json curve = closed_object({{"group", kInt},
+                                              {"speed_rpm", kNum},
+                                              {"load_Nm", kNum},
+                                              {"configuration", kStr},
+                                              {"points_used", kInt},
+                                              {"finished", kBool},
+                                              {"angle_u_target_met", kBool},
+                                              {"mtpa", optimum},
+                                              {"me", optimum}});
+  const synbench::Json adaptive = closed_object({{"curves", {{"type", "array"}, {"items", curve}}},
+                                                 {"points_used", kInt},
+                                                 {"grid_points", kInt},
+                                                 {"grid_step_deg", kNum},
+                                                 {"angle_u_target_deg", nullable(kNum)},
+                                                 {"curves_target_met", kInt}},
+                                                true);
+  const synbench::Json precision = closed_object({{"pdcm_u_repeat_target_W", kNum},
+                                                  {"points", kInt},
+                                                  {"points_missed", kInt},
+                                                  {"missed_indices", {{"type", "array"}, {"items", kInt}}}},
+                                                 true);
+  return closed_object({{"adaptive", adaptive}, {"precision", precision}});
+}
+
 synbench::Json uncertainty_schema() {
   const synbench::Json counted = closed_object({{"known", kInt}, {"significant", kInt}});
   const synbench::Json trajectory =
@@ -241,14 +272,15 @@ synbench::Json analysis_schema() {
             {"deltas", deltas_schema()},
             {"efficiency_map", efficiency_map_schema()},
             {"efficiency_contours", contours_schema()},
-            {"uncertainty", uncertainty_schema()}}},
+            {"uncertainty", uncertainty_schema()},
+            {"sweep_outcome", sweep_outcome_schema()}}},
           {"description", "docs/analysis.md"}};
 }
 
 synbench::Json estimate_schema(bool with_plan) {
   synbench::Json p = {{"points", kInt},        {"upper_bound", kBool},          {"groups", kInt},
                       {"speed_changes", kInt}, {"load_changes", kInt},          {"configuration_changes", kInt},
-                      {"bench_time_s", kNum}};
+                      {"bench_time_s", kNum},  {"precision_extra_s", kNum}};
   if (with_plan) {
     p["duration_s"] = kNum;
     p["plan"] = {{"type", "object"}, {"description", "the canonical plan (docs/sweep-plan.md)"}};

@@ -11,6 +11,7 @@
 
 #include "app/report/sweep_report.hpp"
 #include "bench/analysis.hpp"
+#include "bench/sweep_outcome.hpp"
 #include "bench/sweep_plan.hpp"
 #include "bench/sweep_plan_bench_limits.hpp"
 #include "bench/sweep_presets.hpp"
@@ -178,6 +179,8 @@ synbench::Json plan_schema() {
             {"adaptive", object},
             {"gate", object},
             {"window_s", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 3600}}},
+            {"precision", {{"type", "object"}, {"nullable", true},
+                           {"description", "measure until sure: pdcm_u_repeat_target_W, max_window_s, mode"}}},
             {"thermal", object},
             {"limits", object},
             {"notes", {{"type", "array"}, {"items", {{"type", "string"}}}}}}}};
@@ -348,7 +351,8 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                                                                 "' is not ESTIMATOR/PWM (e.g. encoder/capwm)");
                   options.reference = *ref;
                 }
-                if (auto s = sweep->store.get_sweep(sweep->id); !s) return db_error(s.error());
+                const auto s = sweep->store.get_sweep(sweep->id);
+                if (!s) return db_error(s.error());
                 auto rows = sweep->store.points(sweep->id);
                 if (!rows) return db_error(rows.error());
                 std::vector<bench::PointRecord> records;
@@ -360,7 +364,14 @@ void add_sweep_routes(Router& router, db::Store& store, BenchRuntime& bench, Con
                   r.content_type = "text/csv; charset=utf-8";
                   r.body = bench::analysis_curves_csv(analysis);
                 } else {
-                  r.body = dump_json(bench::to_json(analysis));
+                  auto j = bench::to_json(analysis);
+                  // The adaptive searches and the precision target, replayed from the stored points.
+                  if (const auto plan = bench::parse_sweep_plan(s->meta.plan).plan) {
+                    std::map<std::size_t, bench::PointRecord> by_index;
+                    for (const auto& row : *rows) by_index[static_cast<std::size_t>(row.index)] = row.record;
+                    j["sweep_outcome"] = bench::to_json(bench::sweep_outcome(*plan, by_index));
+                  }
+                  r.body = dump_json(j);
                 }
                 return r;
               })},

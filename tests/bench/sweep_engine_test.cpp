@@ -15,6 +15,8 @@
 #include "drivers/error.hpp"
 #include "emulator/twin_bench.hpp"
 #include "tests/bench/fixed_angle_drive.hpp"
+#include "bench/analysis.hpp"
+#include "bench/sweep_outcome.hpp"
 
 namespace synbench::bench {
 namespace {
@@ -346,6 +348,135 @@ TEST(SweepEngine, TheLockGuardKeepsAnEemfRlsSweepGoingWhereItTripped) {
   bool logged = false;
   for (const auto& ev : guarded.events) logged = logged || ev.find("lock guard") != std::string::npos;
   EXPECT_TRUE(logged);
+}
+
+// ------------------------------------------------------------ measure until sure
+
+// One point at 700 rpm, 2.5 N m, 56 deg over `window_s`, with an optional precision section.
+SweepPlan one_point(double window_s, const std::string& precision) {
+  return plan_from((R"({"dimensions": {"speed_rpm": [700], "load_Nm": [2.5], "angle_deg": [56]},
+    "thermal": {"enabled": false}, "window_s": )" + std::to_string(window_s) +
+                    (precision.empty() ? "" : ", \"precision\": " + precision) + "}")
+                       .c_str());
+}
+
+std::size_t count_events(const VectorSink& sink, const std::string& what) {
+  return static_cast<std::size_t>(std::count_if(sink.events.begin(), sink.events.end(), [&](const std::string& ev) {
+    return ev.find(what) != std::string::npos;
+  }));
+}
+
+TEST(SweepEngine, LengthensAPointsWindowUntilItsPdcmUIsBelowTheTarget) {
+  // The point's u over a short window, without a target.
+  TwinRun plain_run;
+  VectorSink plain;
+  SweepEngine e0(plain_run.bench.devices(), plain_run.sup, one_point(0.3, ""), {}, plain);
+  plain_run.until(e0, 120);
+  ASSERT_EQ(plain.points.size(), 1u);
+  ASSERT_TRUE(plain.points[0].second.pdcm_u_repeat_W);
+  const double u0 = *plain.points[0].second.pdcm_u_repeat_W;
+  EXPECT_NEAR(plain.points[0].second.window_s, 0.3, 0.02);
+
+  // A target 1.6 times below it: about 0.3 x 1.6^2 x 1.2 = 0.92 s predicted.
+  const double target = u0 / 1.6;
+  char precision[120];
+  std::snprintf(precision, sizeof precision, R"({"pdcm_u_repeat_target_W": %.6g, "max_window_s": 4})", target);
+  TwinRun run;
+  VectorSink sink;
+  SweepEngine e(run.bench.devices(), run.sup, one_point(0.3, precision), {}, sink);
+  run.until(e, 120);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  ASSERT_EQ(sink.points.size(), 1u) << "only the final record is stored";
+  const auto& [index, r] = sink.points[0];
+  EXPECT_EQ(index, 0u) << "at the point's own index";
+  EXPECT_GE(count_events(sink, "point 0: pdcm_u_repeat_W"), 1u);
+  EXPECT_EQ(count_events(sink, "precision target missed"), 0u);
+  EXPECT_GT(r.window_s, 0.8);
+  EXPECT_LE(r.window_s, 4.0);
+  ASSERT_TRUE(r.pdcm_u_repeat_W);
+  EXPECT_LE(*r.pdcm_u_repeat_W, target);
+  EXPECT_FALSE(r.unstable);
+  // The drives kept running: no ordered stop between the windows (one "sweep completed" stop).
+  EXPECT_EQ(count_events(sink, "drives stopped"), 0u);
+  std::printf("precision: u %.4f W over 0.3 s; target %.4f W reached with %.4f W over %.2f s\n", u0, target,
+              *r.pdcm_u_repeat_W, r.window_s);
+  for (const auto& ev : sink.events) std::printf("  %s\n", ev.c_str());
+  EXPECT_EQ(sweep_outcome(one_point(0.3, precision), {{index, r}}).precision->missed.size(), 0u);
+
+  // A target out of reach within a 1 s cap: stored with what it reached, flagged, never dropped.
+  std::snprintf(precision, sizeof precision, R"({"pdcm_u_repeat_target_W": %.6g, "max_window_s": 1})", u0 / 100);
+  TwinRun capped_run;
+  VectorSink capped;
+  const SweepPlan capped_plan = one_point(0.3, precision);
+  SweepEngine e2(capped_run.bench.devices(), capped_run.sup, capped_plan, {}, capped);
+  capped_run.until(e2, 120);
+  ASSERT_EQ(e2.state(), SweepState::completed) << e2.error();
+  ASSERT_EQ(capped.points.size(), 1u);
+  EXPECT_NEAR(capped.points[0].second.window_s, 1.0, 0.02);
+  EXPECT_EQ(count_events(capped, "point 0: precision target missed"), 1u);
+  EXPECT_EQ(sweep_outcome(capped_plan, {capped.points[0]}).precision->missed, std::vector<std::size_t>{0});
+}
+
+TEST(SweepEngine, AdaptiveSearchMeasuresUntilBothAnglesAreBelowTheTarget) {
+  TwinRun run;
+  VectorSink sink;
+  const SweepPlan plan = plan_from(R"({"mode": "adaptive",
+    "dimensions": {"speed_rpm": [300, 700], "load_Nm": [2.5]},
+    "adaptive": {"angle_u_target_deg": 0.5, "max_evaluations": 20},
+    "window_s": 1, "thermal": {"enabled": false}})");
+  SweepEngine e(run.bench.devices(), run.sup, plan, {}, sink);
+  run.until(e, 1200);
+  ASSERT_EQ(e.state(), SweepState::completed) << e.error();
+  std::map<std::size_t, PointRecord> stored(sink.points.begin(), sink.points.end());
+  const auto o = sweep_outcome(plan, stored);
+  std::printf("%s", to_text(o).c_str());
+  ASSERT_EQ(o.curves.size(), 2u);
+  std::vector<PointRecord> records;
+  for (const auto& [i, r] : sink.points) records.push_back(r);
+  const auto analysis = analyze(records);
+  ASSERT_EQ(analysis.curves.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& c = o.curves[k];
+    EXPECT_TRUE(c.result.angle_u_target_met) << k;
+    EXPECT_LT(c.result.evaluations, 20u) << k;
+    ASSERT_TRUE(c.result.mtpa.angle_u_deg && c.result.me.angle_u_deg);
+    EXPECT_LE(*c.result.mtpa.angle_u_deg, 0.5);
+    EXPECT_LE(*c.result.me.angle_u_deg, 0.5);
+    // The analysis on the same points (its three-point refinement, its Monte Carlo).
+    const auto& a = analysis.curves[k];
+    ASSERT_TRUE(a.mtpa.angle_u_deg && a.me.angle_u_deg);
+    std::printf("curve %zu: search MTPA %.2f +/- %.2f, ME %.2f +/- %.2f; analysis MTPA %.2f +/- %.2f, ME %.2f +/- %.2f deg\n",
+                k, c.result.mtpa.angle_deg, *c.result.mtpa.angle_u_deg, c.result.me.angle_deg,
+                *c.result.me.angle_u_deg, a.mtpa.angle_deg, *a.mtpa.angle_u_deg, a.me.angle_deg, *a.me.angle_u_deg);
+    EXPECT_LE(*a.mtpa.angle_u_deg, 0.5) << k;
+    EXPECT_LE(*a.me.angle_u_deg, 0.5) << k;
+  }
+  EXPECT_LT(o.points_used, o.grid_points);
+
+  // The twin's scatter over 1 s puts both angles within a few 0.01 deg from five points; a
+  // target of 0.01 deg over 0.2 s windows needs more points per curve, or runs to the cap of 12
+  // and says so.
+  TwinRun tight_run;
+  VectorSink tight;
+  const SweepPlan tight_plan = plan_from(R"({"mode": "adaptive",
+    "dimensions": {"speed_rpm": [300, 700], "load_Nm": [2.5]},
+    "adaptive": {"angle_u_target_deg": 0.01, "max_evaluations": 12},
+    "window_s": 0.2, "thermal": {"enabled": false}})");
+  SweepEngine e2(tight_run.bench.devices(), tight_run.sup, tight_plan, {}, tight);
+  tight_run.until(e2, 1200);
+  ASSERT_EQ(e2.state(), SweepState::completed) << e2.error();
+  const auto o2 = sweep_outcome(tight_plan, std::map<std::size_t, PointRecord>(tight.points.begin(), tight.points.end()));
+  std::printf("%s", to_text(o2).c_str());
+  ASSERT_EQ(o2.curves.size(), 2u);
+  EXPECT_GT(o2.points_used, o.points_used);
+  for (const auto& c : o2.curves) {
+    EXPECT_TRUE(c.finished);
+    if (c.result.angle_u_target_met) {
+      EXPECT_LT(c.result.evaluations, 12u);
+    } else {
+      EXPECT_EQ(c.result.evaluations, 12u);
+    }
+  }
 }
 
 }  // namespace

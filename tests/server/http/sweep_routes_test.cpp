@@ -14,6 +14,8 @@
 #include "server/cli/bench_setup.hpp"
 #include "server/http/api_routes.hpp"
 #include "server/http/json_schema.hpp"
+#include "bench/point_record.hpp"
+#include "bench/sweep_plan_angle_search.hpp"
 
 namespace synbench::http {
 namespace {
@@ -136,6 +138,65 @@ TEST_F(SweepRoutes, LiveAnswersConformToThePublishedSchemas) {
   sweep.erase("points_stored");
   const auto& sweep_schema = doc["paths"]["/api/sweeps/{id}"]["get"]["responses"]["200"]["content"]["application/json"]["schema"];
   EXPECT_EQ(to_string(validate(sweep_schema, sweep)), "/points_stored: required field is missing");
+}
+
+// An adaptive plan with an angle u target and a precision target, created over REST: the
+// analysis carries the searches replayed from the stored points (sweep_outcome), and conforms.
+TEST_F(SweepRoutes, AnalysisCarriesTheSweepOutcome) {
+  const auto created = call("POST", "/api/sweeps", R"({"name": "until sure", "mode": "adaptive",
+    "dimensions": {"speed_rpm": [300], "load_Nm": [2]},
+    "adaptive": {"angle_u_target_deg": 0.5, "max_evaluations": 25},
+    "precision": {"pdcm_u_repeat_target_W": 0.04, "max_window_s": 4}})");
+  ASSERT_EQ(created.status, 201) << created.body;
+  const auto id = synbench::Json::parse(created.body)["id"].get<std::int64_t>();
+  // Stored as the engine stores them: the search's proposals at group * max_evaluations + e.
+  bench::AngleSearchOptions opt;
+  opt.max_evaluations = 25;
+  opt.angle_u_target_deg = 0.5;
+  bench::AngleSearch search(opt);
+  std::size_t e = 0;
+  while (auto a = search.next_angle()) {
+    bench::PointRecord r;
+    r.speed_rpm = 300;
+    r.load_Nm = 2;
+    r.angle_deg = *a;
+    r.im_A = 2 * (1 + 4e-4 * (*a - 51.3) * (*a - 51.3));
+    r.pdcm_W = 60 + 0.01 * (*a - 53.1) * (*a - 53.1);
+    r.im_u_A = r.im_u_repeat_A = 0.002;
+    r.pdcm_u_W = r.pdcm_u_repeat_W = e == 0 ? 0.05 : 0.03;  // the first point above the 0.04 W target
+    search.report(r.angle_deg, r.im_A, r.pdcm_W, r.im_u_repeat_A, r.pdcm_u_repeat_W);
+    ASSERT_TRUE(store.insert_point(id, static_cast<std::int64_t>(e++), r));
+  }
+  const auto answer = call("GET", "/api/sweeps/" + std::to_string(id) + "/analysis", "", "view");
+  ASSERT_EQ(answer.status, 200) << answer.body;
+  const auto j = synbench::Json::parse(answer.body);
+  const auto& o = j["sweep_outcome"];
+  ASSERT_TRUE(o["adaptive"].is_object()) << answer.body;
+  EXPECT_EQ(o["adaptive"]["points_used"], e);
+  EXPECT_EQ(o["adaptive"]["grid_points"], 19);
+  EXPECT_EQ(o["adaptive"]["curves_target_met"], 1);
+  EXPECT_EQ(o["adaptive"]["curves"][0]["angle_u_target_met"], true);
+  EXPECT_LE(o["adaptive"]["curves"][0]["mtpa"]["angle_u_deg"].get<double>(), 0.5);
+  EXPECT_EQ(o["precision"]["points_missed"], 1);
+  EXPECT_EQ(o["precision"]["missed_indices"], synbench::Json::array({0}));
+  const auto doc = synbench::Json::parse(call("GET", "/api/openapi.json").body);
+  const auto& schema =
+      doc["paths"]["/api/sweeps/{id}/analysis"]["get"]["responses"]["200"]["content"]["application/json"]["schema"];
+  EXPECT_EQ(to_string(validate(schema, j)), "");
+  // The estimate of the same plan is an upper bound with the longer windows.
+  const auto est = call("POST", "/api/sweeps/estimate", R"({"dimensions": {"speed_rpm": [300], "load_Nm": [2], "angle_deg": [50]},
+    "precision": {"pdcm_u_repeat_target_W": 0.04, "max_window_s": 4}})", "view");
+  ASSERT_EQ(est.status, 200) << est.body;
+  const auto ej = synbench::Json::parse(est.body);
+  EXPECT_EQ(ej["upper_bound"], true);
+  EXPECT_GT(ej["precision_extra_s"].get<double>(), 8.0);  // twice at least the 4 s cap
+  EXPECT_EQ(ej["plan"]["precision"]["max_window_s"], 4.0);
+  // Refused at its pointer over REST as on the command line.
+  const auto bad = call("POST", "/api/sweeps/estimate", R"({"dimensions": {"speed_rpm": [300], "load_Nm": [2], "angle_deg": [50]},
+    "precision": {"pdcm_u_repeat_target_W": -1}})", "view");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_NE(error_text(bad).find("/precision/pdcm_u_repeat_target_W: must be within (0, 1000] W"), std::string::npos)
+      << error_text(bad);
 }
 
 }  // namespace
