@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
 """`synbench study` as a user and a cluster run it: a refused plan names its JSON pointers; a
-study sharded over 4 processes writing at once into one SQLite file, one of them killed with
+study sharded over 4 processes writing at once into one SQLite file (and then into a throwaway
+PostgreSQL cluster, tests/db/pg_cluster.sh), one of them killed with
 SIGKILL mid-sample and re-run, ends with every sample complete, no point stored twice, and the
 same merged analysis as an unkilled single-process run; `status` counts the shards; the
 Kubernetes Indexed Job and Slurm array scripts parse and the command lines they run are accepted
 (with --dry-run) and give each shard its own samples.
 
 Usage: study_test.py SYNBENCH [SOURCE_DIR]"""
+import glob
 import json
 import os
 import re
@@ -73,27 +75,35 @@ check(not os.path.exists(os.path.join(tmp, "never.db")), "dry run opens no store
 plan_hash = keys[0][0] if keys else ""
 
 
-def points_per_sweep(db):
-    con = sqlite3.connect(db)
+PSQL = next(iter(sorted(glob.glob("/usr/lib/postgresql/*/bin/psql"), reverse=True)), None)
+
+
+def query(db, sql):
+    """Rows of `sql` on a SQLite file or a postgresql:// URL (psql)."""
+    if db.startswith("postgresql://"):
+        p = subprocess.run([PSQL, "-At", "-F", "\t", db, "-c", sql], capture_output=True, text=True, timeout=30)
+        if p.returncode != 0:
+            return []
+        return [tuple(int(x) if x.isdigit() else x for x in line.split("\t")) for line in p.stdout.splitlines()]
+    if not os.path.exists(db):
+        return []
     try:
-        rows = con.execute("SELECT s.key, s.state, COUNT(p.id), COUNT(DISTINCT p.point_index) FROM sweeps s "
-                           "LEFT JOIN points p ON p.sweep_id = s.id GROUP BY s.id").fetchall()
-    finally:
+        con = sqlite3.connect(db, timeout=5)
+        rows = con.execute(sql).fetchall()
         con.close()
-    return rows
+        return rows
+    except sqlite3.Error:
+        return []
+
+
+def points_per_sweep(db):
+    return sorted(query(db, "SELECT s.key, s.state, COUNT(p.id), COUNT(DISTINCT p.point_index) FROM sweeps s "
+                            "LEFT JOIN points p ON p.sweep_id = s.id GROUP BY s.id, s.key, s.state"))
 
 
 def stored_points(db, shard, shards):
-    if not os.path.exists(db):
-        return 0
-    try:
-        con = sqlite3.connect(db, timeout=5)
-        rows = con.execute("SELECT s.key, COUNT(p.id) FROM sweeps s JOIN points p ON p.sweep_id = s.id "
-                           "GROUP BY s.id").fetchall()
-        con.close()
-    except sqlite3.Error:
-        return 0
-    return sum(n for name, n in rows if int(name.rsplit("/", 1)[1]) % shards == shard)
+    rows = query(db, "SELECT s.key, COUNT(p.id) FROM sweeps s JOIN points p ON p.sweep_id = s.id GROUP BY s.id, s.key")
+    return sum(n for key, n in rows if int(key.rsplit("/", 1)[1]) % shards == shard)
 
 
 # --- reference: one process, all samples ---
@@ -107,96 +117,119 @@ check(code == 0 and "eemf-lut/capwm" in out, f"analyse prints the table ({code})
 print(out, flush=True)
 ref = json.load(open(os.path.join(tmp, "ref.json")))
 
-# --- 4 shards at once into one file, shard 2 killed mid-sample ---
-db = os.path.join(tmp, "shared.db")
-procs = {k: subprocess.Popen([BIN, "study", "run", plan, "--shard", f"{k}/4", "--db", db],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for k in range(4)}
-victim, killed_at = 2, None
-deadline = time.monotonic() + 300
-while time.monotonic() < deadline and procs[victim].poll() is None:
-    n = stored_points(db, victim, 4)
-    if n >= 1 and n % POINTS_PER_SAMPLE != 0:  # inside a sample, not between two
-        procs[victim].send_signal(signal.SIGKILL)
-        killed_at = n
-        break
-    time.sleep(0.005)
-results = {k: (p.wait(timeout=600), p.stderr.read()) for k, p in procs.items()}
-check(killed_at is not None and results[victim][0] == -signal.SIGKILL,
-      f"shard {victim} killed with SIGKILL after {killed_at} points, mid-sample ({results[victim][0]})")
-for k in range(4):
-    if k != victim:
-        check(results[k][0] == 0, f"shard {k}/4 completes beside the others ({results[k][0]}: {results[k][1].strip()[-300:]})")
+# --- 4 shards at once into one store, shard 2 killed mid-sample ---
+def sharded_study(db, label):
+    """4 shards at once into `db`, shard 2 killed mid-sample and re-run; against the reference."""
+    def chk(cond, what):
+        return check(cond, f"[{label}] {what}")
 
-code, out, err = study("status", plan, "--db", db, "--shards", "4", "--json")
-st = json.loads(out) if code == 0 else {"shards": []}
-by_shard = {s["shard"]: s for s in st["shards"]}
-v = by_shard.get(f"{victim}/4", {})
-check(v.get("running") == 1 and v.get("done", 0) < v.get("samples", 0),
-      f"status: the killed shard has its sample left running ({v})")
-check(all(by_shard.get(f"{k}/4", {}).get("done") == 2 for k in range(4) if k != victim),
-      f"status: the other shards are done ({st['shards']})")
+    procs = {k: subprocess.Popen([BIN, "study", "run", plan, "--shard", f"{k}/4", "--db", db],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for k in range(4)}
+    victim, killed_at = 2, None
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and procs[victim].poll() is None:
+        n = stored_points(db, victim, 4)
+        if n >= 1 and n % POINTS_PER_SAMPLE != 0:  # inside a sample, not between two
+            procs[victim].send_signal(signal.SIGKILL)
+            killed_at = n
+            break
+        time.sleep(0.005)
+    results = {k: (p.wait(timeout=600), p.stderr.read()) for k, p in procs.items()}
+    chk(killed_at is not None and results[victim][0] == -signal.SIGKILL,
+          f"shard {victim} killed with SIGKILL after {killed_at} points, mid-sample ({results[victim][0]})")
+    for k in range(4):
+        if k != victim:
+            chk(results[k][0] == 0, f"shard {k}/4 completes beside the others ({results[k][0]}: {results[k][1].strip()[-300:]})")
 
-# Re-run the killed shard: resumes, stores only what is missing.
-code, out, err = study("run", plan, "--shard", f"{victim}/4", "--db", db)
-check(code == 0, f"re-run of shard {victim} completes ({code}, {err.strip()[-300:]})")
-resumed = [int(b) for b in re.findall(r"\((\d+) before this run\)", err)]
-check(killed_at is not None and any(killed_at % POINTS_PER_SAMPLE <= b < POINTS_PER_SAMPLE for b in resumed if b > 0),
-      f"re-run resumes the killed sample at its first missing point ({err.strip()})")
-# Re-running a complete shard stores nothing.
-before = points_per_sweep(db)
-code, out, err = study("run", plan, "--shard", "0/4", "--db", db)
-check(code == 0 and err.count("already complete") == 2 and points_per_sweep(db) == before,
-      f"re-running a complete shard stores nothing ({err.strip()})")
+    code, out, err = study("status", plan, "--db", db, "--shards", "4", "--json")
+    st = json.loads(out) if code == 0 else {"shards": []}
+    by_shard = {s["shard"]: s for s in st["shards"]}
+    v = by_shard.get(f"{victim}/4", {})
+    chk(v.get("running") == 1 and v.get("done", 0) < v.get("samples", 0),
+          f"status: the killed shard has its sample left running ({v})")
+    chk(all(by_shard.get(f"{k}/4", {}).get("done") == 2 for k in range(4) if k != victim),
+          f"status: the other shards are done ({st['shards']})")
 
-rows = points_per_sweep(db)
-check(len(rows) == SAMPLES, f"one sweep per sample ({len(rows)})")
-check(all(state == "completed" and n == POINTS_PER_SAMPLE and d == n for _, state, n, d in rows),
-      f"every sample completed with each point once ({rows})")
-check(sorted(int(name.rsplit("/", 1)[1]) for name, *_ in rows) == list(range(SAMPLES))
-      and all(name.startswith(f"ld-rs/{plan_hash}/") for name, *_ in rows), "sweeps stored under their keys")
-code, out, err = study("status", plan, "--db", db, "--shards", "4", "--json")
-st = json.loads(out)
-check(all(s["done"] == s["samples"] and s["missing"] == 0 and s["running"] == 0 for s in st["shards"]),
-      f"status after the re-run: every shard done ({st['shards']})")
+    # Re-run the killed shard: resumes, stores only what is missing.
+    code, out, err = study("run", plan, "--shard", f"{victim}/4", "--db", db)
+    chk(code == 0, f"re-run of shard {victim} completes ({code}, {err.strip()[-300:]})")
+    resumed = [int(b) for b in re.findall(r"\((\d+) before this run\)", err)]
+    chk(killed_at is not None and any(killed_at % POINTS_PER_SAMPLE <= b < POINTS_PER_SAMPLE for b in resumed if b > 0),
+          f"re-run resumes the killed sample at its first missing point ({err.strip()})")
+    # Re-running a complete shard stores nothing.
+    before = points_per_sweep(db)
+    code, out, err = study("run", plan, "--shard", "0/4", "--db", db)
+    chk(code == 0 and err.count("already complete") == 2 and points_per_sweep(db) == before,
+          f"re-running a complete shard stores nothing ({err.strip()})")
 
-code, out, err = study("analyse", plan, "--db", db, "--json-out", os.path.join(tmp, "sharded.json"))
-check(code == 0, f"analyse the sharded study ({code})")
-sharded = json.load(open(os.path.join(tmp, "sharded.json")))
+    rows = points_per_sweep(db)
+    chk(len(rows) == SAMPLES, f"one sweep per sample ({len(rows)})")
+    chk(all(state == "completed" and n == POINTS_PER_SAMPLE and d == n for _, state, n, d in rows),
+          f"every sample completed with each point once ({rows})")
+    chk(sorted(int(name.rsplit("/", 1)[1]) for name, *_ in rows) == list(range(SAMPLES))
+          and all(name.startswith(f"ld-rs/{plan_hash}/") for name, *_ in rows), "sweeps stored under their keys")
+    code, out, err = study("status", plan, "--db", db, "--shards", "4", "--json")
+    st = json.loads(out)
+    chk(all(s["done"] == s["samples"] and s["missing"] == 0 and s["running"] == 0 for s in st["shards"]),
+          f"status after the re-run: every shard done ({st['shards']})")
 
-
-def cells(a):
-    out = {}
-    for p in a["parameters"]:
-        for g in p["groups"]:
-            for c in g["configurations"]:
-                out[(p["parameter"], g["from"], c["configuration"])] = c
-    return out
+    code, out, err = study("analyse", plan, "--db", db, "--json-out", os.path.join(tmp, label + ".json"))
+    chk(code == 0, f"analyse the sharded study ({code})")
+    sharded = json.load(open(os.path.join(tmp, label + ".json")))
 
 
-# Samples that were not killed are bit-identical (same twin, same seed); the resumed sample's
-# points after the kill start from standstill on a fresh twin, so they agree to the noise.
-check(sharded["points"] == ref["points"] == SAMPLES * POINTS_PER_SAMPLE, f"merged points ({sharded['points']})")
-a, b = cells(ref), cells(sharded)
-check(a.keys() == b.keys(), "same groups and configurations")
-tol = {"pos_err_abs_mean_deg": 0.3, "pos_err_abs_max_deg": 3.0, "speed_err_abs_mean_rpm": 3.0,
-       "efficiency_mean": 0.003, "mtpa_angle_mean_deg": 1.0, "mtpa_shift_deg": 1.0}
-worst = {}
-for k in a:
-    check(a[k]["samples"] == b[k]["samples"] and a[k]["points"] == b[k]["points"], f"{k}: same samples and points")
+    def cells(a):
+        out = {}
+        for p in a["parameters"]:
+            for g in p["groups"]:
+                for c in g["configurations"]:
+                    out[(p["parameter"], g["from"], c["configuration"])] = c
+        return out
+
+
+    # Samples that were not killed are bit-identical (same twin, same seed); the resumed sample's
+    # points after the kill start from standstill on a fresh twin, so they agree to the noise.
+    chk(sharded["points"] == ref["points"] == SAMPLES * POINTS_PER_SAMPLE, f"merged points ({sharded['points']})")
+    a, b = cells(ref), cells(sharded)
+    chk(a.keys() == b.keys(), "same groups and configurations")
+    tol = {"pos_err_abs_mean_deg": 0.3, "pos_err_abs_max_deg": 3.0, "speed_err_abs_mean_rpm": 3.0,
+           "efficiency_mean": 0.003, "mtpa_angle_mean_deg": 1.0, "mtpa_shift_deg": 1.0}
+    worst = {}
+    for k in a:
+        chk(a[k]["samples"] == b[k]["samples"] and a[k]["points"] == b[k]["points"], f"{k}: same samples and points")
+        for f, t in tol.items():
+            if a[k][f] is None or b[k][f] is None:
+                chk(a[k][f] is None and b[k][f] is None, f"{k} {f}: both null")
+                continue
+            worst[f] = max(worst.get(f, 0), abs(a[k][f] - b[k][f]))
     for f, t in tol.items():
-        if a[k][f] is None or b[k][f] is None:
-            check(a[k][f] is None and b[k][f] is None, f"{k} {f}: both null")
-            continue
-        worst[f] = max(worst.get(f, 0), abs(a[k][f] - b[k][f]))
-for f, t in tol.items():
-    check(worst.get(f, 0) <= t, f"merged {f} matches the unkilled run within {t} (worst {worst.get(f, 0):.4g})")
+        chk(worst.get(f, 0) <= t, f"merged {f} matches the unkilled run within {t} (worst {worst.get(f, 0):.4g})")
 
-# The sensitivity shows: EEMF-LUT's position error grows with |Ld deviation|.
-ld = {g["from"]: next(c for c in g["configurations"] if c["configuration"] == "eemf-lut/capwm")
-      for g in next(p for p in ref["parameters"] if p["parameter"] == "ld_pct")["groups"]}
-check(ld[-25]["pos_err_abs_mean_deg"] > ld[0]["pos_err_abs_mean_deg"] + 0.5,
-      f"EEMF-LUT |position error| at Ld -25 % ({ld[-25]['pos_err_abs_mean_deg']:.2f}) above nominal "
-      f"({ld[0]['pos_err_abs_mean_deg']:.2f})")
+    # The sensitivity shows: EEMF-LUT's position error grows with |Ld deviation|.
+    ld = {g["from"]: next(c for c in g["configurations"] if c["configuration"] == "eemf-lut/capwm")
+          for g in next(p for p in ref["parameters"] if p["parameter"] == "ld_pct")["groups"]}
+    chk(ld[-25]["pos_err_abs_mean_deg"] > ld[0]["pos_err_abs_mean_deg"] + 0.5,
+          f"EEMF-LUT |position error| at Ld -25 % ({ld[-25]['pos_err_abs_mean_deg']:.2f}) above nominal "
+          f"({ld[0]['pos_err_abs_mean_deg']:.2f})")
+
+
+
+
+sharded_study(os.path.join(tmp, "shared.db"), "sqlite")
+
+# The same on a throwaway PostgreSQL 15 cluster (tests/db/pg_cluster.sh); no PostgreSQL: a failure.
+pg_dir = tempfile.mkdtemp(prefix="synbench-study-pg-")  # /tmp-level: the cluster's owner (nobody as root) reaches it
+p = subprocess.run(["sh", os.path.join(SRC, "tests", "db", "pg_cluster.sh"), "start", pg_dir],
+                   capture_output=True, text=True, timeout=120)
+if check(p.returncode == 0 and PSQL, f"PostgreSQL cluster started ({p.stderr.strip()[-300:]})"):
+    port = p.stdout.strip().splitlines()[-1]
+    try:
+        subprocess.run([PSQL, f"postgresql://synbench@127.0.0.1:{port}/postgres", "-c", "CREATE DATABASE study"],
+                       capture_output=True, check=True, timeout=30)
+        sharded_study(f"postgresql://synbench@127.0.0.1:{port}/study", "postgresql")
+    finally:
+        subprocess.run(["sh", os.path.join(SRC, "tests", "db", "pg_cluster.sh"), "stop", pg_dir],
+                       capture_output=True, timeout=120)
 
 # --- cluster manifests ---
 job_path = os.path.join(SRC, "deploy", "k8s", "study-job.yaml")
