@@ -102,7 +102,7 @@ int run(const bench::StudyPlan& plan, bench::Shard shard, const std::string& db_
   if (dry_run) {
     std::cout << "study " << plan.name << " (" << bench::plan_hash(plan) << "): shard " << shard.index << "/"
               << shard.count << ": " << mine.size() << " of " << bench::sample_count(plan) << " samples, "
-              << bench::estimate(plan.sweep).points << " points each, into " << db_target << "\n";
+              << bench::estimate(plan.sweep).points << " points each, into " << db::shown_target(db_target) << "\n";
     for (auto i : mine) {
       const auto s = bench::sample(plan, i);
       std::string error;
@@ -133,7 +133,7 @@ int run(const bench::StudyPlan& plan, bench::Shard shard, const std::string& db_
   auto prev_term = std::signal(SIGTERM, on_signal);
   if (!quiet)
     std::cerr << "study " << plan.name << ": shard " << shard.index << "/" << shard.count << ", " << mine.size()
-              << " samples into " << db_target << "\n";
+              << " samples into " << db::shown_target(db_target) << "\n";
   const auto report = app::run_study_shard(*store, plan, shard, options, [&](const app::StudySampleOutcome& o) {
     if (quiet && o.error.empty()) return;
     std::cerr << "sample " << o.index << " (" << o.key << ", sweep " << o.sweep_id << "): " << app::name(o.result)
