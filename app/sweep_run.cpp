@@ -1,6 +1,8 @@
 // A sweep into the store; see sweep_run.hpp.
 #include "app/sweep_run.hpp"
 
+#include "app/supervised_point.hpp"
+
 namespace synbench::app {
 
 class SweepRun::Sink final : public bench::SweepSink {
@@ -71,6 +73,26 @@ std::optional<std::string> SweepRun::finish() {
   if (!engine_->error().empty()) err = engine_->error();
   if (auto r = store_.set_sweep_state(id_, final_state(), err, sparse_); !r) return r.error().message;
   return std::nullopt;
+}
+
+double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, SweepRun& run, double tick_s,
+                  const std::function<bool()>& interrupted, const std::function<void()>& on_abort) {
+  double t = backend.clock().now_s();
+  bool abort_sent = false;
+  while (!run.finished()) {
+    if (!abort_sent && interrupted && interrupted()) {
+      run.engine().abort();
+      abort_sent = true;
+      if (on_abort) on_abort();
+    }
+    t += tick_s;
+    backend.clock().wait_until(t);
+    backend.tick(t);
+    supervisor.tick(t);
+    run.tick(t);
+  }
+  // However the sweep ended, the drives are read back stopped (or the alarm is raised).
+  return confirm_stopped(backend, supervisor, t, tick_s);
 }
 
 }  // namespace synbench::app

@@ -6,11 +6,13 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "app/bench_backend.hpp"
 #include "bench/safety_supervisor.hpp"
 #include "bench/sweep_engine.hpp"
 #include "db/store.hpp"
@@ -55,5 +57,12 @@ class SweepRun {
   std::unique_ptr<Sink> sink_;
   std::unique_ptr<bench::SweepEngine> engine_;
 };
+
+// A headless run (`synbench sweep`, `synbench study run`): ticks the bench, the supervisor and the
+// sweep every `tick_s` of the backend's clock until the sweep ends, then confirms both drives read
+// back stopped. `interrupted` is asked every tick; its first true aborts the sweep (ordered stop,
+// resumable) and calls `on_abort`. Returns the time reached.
+double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, SweepRun& run, double tick_s,
+                  const std::function<bool()>& interrupted = {}, const std::function<void()>& on_abort = {});
 
 }  // namespace synbench::app

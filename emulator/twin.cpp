@@ -29,7 +29,7 @@ struct Twin::Rates {
 Twin::Twin(const TwinConfig& config)
     : cfg_(config),
       ts_(config.step_s()),
-      synrm_(config.synrm),
+      synrm_(config.plant_synrm()),
       inverter_(config.inverter),
       bus_(config.dc_bus),
       vfc_(config.vfc),
@@ -39,6 +39,8 @@ Twin::Twin(const TwinConfig& config)
       load_fw_(config),
       noise_(static_cast<std::uint64_t>(config.sim.seed_int)),
       counts_per_rev_(std::ldexp(1.0, config.encoder.resolution_bits)),
+      encoder_offset_rad_(config.plant.encoder_offset_deg * kPi / 180.0 / config.synrm.pole_pairs),
+      total_inertia_kgm2_(config.plant_synrm().inertia_kgm2 + config.load.inertia_kgm2),
       load_kt_(1.5 * config.load.pole_pairs * config.load.psi_pm_Wb) {
   x_.udc_V = bus_.voltage_V();
 }
@@ -67,7 +69,7 @@ Twin::Rates Twin::evaluate(const PlantState& x, double ua, double ub, bool gates
   r.dx.psi_d_Wb = r.flows.dpsi_d;
   r.dx.psi_q_Wb = r.flows.dpsi_q;
   r.dx.speed_rad_s = (r.flows.torque_Nm - tl - synrm_.friction_torque_Nm(wm) - b1g * wm) /
-                     cfg_.total_inertia_kgm2();
+                     total_inertia_kgm2_;
   r.dx.angle_rad = wm;
   r.dx.load_iq_A = (load_iref - x.load_iq_A) * 2.0 * kPi * cfg_.load.current_bandwidth_Hz;
 
@@ -150,7 +152,7 @@ void Twin::step() {
   firmware::DriveSample sample;
   sample.ia_A = i_ph[0] + sigma * noise_.gauss() + faults_.phase_a_sensor_offset_A;
   sample.ib_A = i_ph[1] + sigma * noise_.gauss();
-  sample.encoder_count = static_cast<std::int64_t>(std::floor(x_.angle_rad / (2.0 * kPi) * counts_per_rev_));
+  sample.encoder_count = static_cast<std::int64_t>(std::floor((x_.angle_rad + encoder_offset_rad_) / (2.0 * kPi) * counts_per_rev_));
   sample.udc_V = udc;
   sample.temp_C = thermal_.temp_C();
   sample.mcidc = mcidc_sample_;

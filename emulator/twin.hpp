@@ -99,6 +99,8 @@ class Twin {
   firmware::LoadDriveFirmware load_fw_;
   Noise noise_;
   double counts_per_rev_;
+  double encoder_offset_rad_;  // mechanical: the plant's encoder mounting offset
+  double total_inertia_kgm2_;  // the plant's, SynRM and load machine
   double load_kt_;
 
   PlantFaults faults_;

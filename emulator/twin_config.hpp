@@ -64,6 +64,18 @@ struct EncoderParams {
   int resolution_bits = 12;
 };
 
+// The machine as built against the model the drive firmware and its estimators hold (synrm):
+// factors on the plant's flux maps, resistance and inertia, and the encoder's mounting offset.
+// The firmware keeps the nominal synrm values, so a study can ask how an estimator's error grows
+// when the machine differs from its model (thesis Ch. 4; docs/study.md). 1 and 0: the model.
+struct PlantParams {
+  double flux_d_scale = 1.0;     // the plant's Psi_d(i_d) = scale x the model's (Ld, every branch)
+  double flux_q_scale = 1.0;     // the same for Psi_q(i_q)
+  double rs_scale = 1.0;         // the plant's R_s = scale x synrm.rs_ohm (at every temperature)
+  double inertia_scale = 1.0;    // the SynRM rotor's J = scale x synrm.inertia_kgm2
+  double encoder_offset_deg = 0;  // electrical: the encoder reads the rotor this far ahead
+};
+
 struct InverterParams {
   double pwm_frequency_Hz = 10000.0;
   double dead_time_s = 1.0e-6;
@@ -194,6 +206,7 @@ struct TwinConfig {
   ThermalParams thermal;
   LoadParams load;
   EncoderParams encoder;
+  PlantParams plant;
   InverterParams inverter;
   DcBusParams dc_bus;
   VfcParams vfc;
@@ -203,6 +216,8 @@ struct TwinConfig {
   SimParams sim;
 
   double total_inertia_kgm2() const { return synrm.inertia_kgm2 + load.inertia_kgm2; }
+  // The plant's machine: synrm with plant's factors applied (what the twin simulates).
+  SynrmParams plant_synrm() const;
   double step_s() const { return 1.0 / inverter.pwm_frequency_Hz; }
 
   // Operates the same bus design at another voltage: source voltage set to udc_V, chopper and

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "drivers/json_file.hpp"
 
@@ -93,6 +94,13 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("load.torque_ramp_Nm_per_s", &l.torque_ramp_Nm_per_s, "assumed", "load torque setpoint ramp", A);
 
   b.integer("encoder.resolution_bits", &c.encoder.resolution_bits, 8, 24, "Sec. 6.1", "encoder resolution");
+
+  auto& pl = c.plant;
+  b.num("plant.flux_d_scale", &pl.flux_d_scale, 0.2, 5, "study", "plant's d-axis flux map / the model's (firmware keeps synrm)");
+  b.num("plant.flux_q_scale", &pl.flux_q_scale, 0.2, 5, "study", "plant's q-axis flux map / the model's");
+  b.num("plant.rs_scale", &pl.rs_scale, 0.2, 5, "study", "plant's stator resistance / synrm.rs_ohm");
+  b.num("plant.inertia_scale", &pl.inertia_scale, 0.2, 5, "study", "plant's SynRM rotor inertia / synrm.inertia_kgm2");
+  b.num("plant.encoder_offset_deg", &pl.encoder_offset_deg, -180, 180, "study", "encoder mounting offset (electrical)");
 
   auto& i = c.inverter;
   b.num("inverter.pwm_frequency_Hz", &i.pwm_frequency_Hz, 1000, 50000, "Sec. 6.1", "PWM frequency = simulation step rate");
@@ -394,6 +402,20 @@ std::string markdown_reference(const TwinConfig& config) {
 }  // namespace synbench::emulator
 
 namespace synbench::emulator {
+
+SynrmParams TwinConfig::plant_synrm() const {
+  SynrmParams p = synrm;
+  // Every term of a flux branch scales, so Psi(i) scales at every current and the knee stays put.
+  for (auto [axis, k] : {std::pair{&p.flux_d, plant.flux_d_scale}, std::pair{&p.flux_q, plant.flux_q_scale}}) {
+    axis->l0_H *= k;
+    axis->psi0_Wb *= k;
+    axis->l1_H *= k;
+    axis->beta_WbA *= k;
+  }
+  p.rs_ohm *= plant.rs_scale;
+  p.inertia_kgm2 *= plant.inertia_scale;
+  return p;
+}
 
 void TwinConfig::scale_bus_to(double udc_V) {
   const double k = udc_V / dc_bus.source_V;

@@ -21,6 +21,7 @@ commands:
   serve     run the daemon: REST API, WebSocket and dashboard over the twin or real drives
   bench     check a bench config and probe its devices, read its drives, clear their faults
   profile   check device profiles
+  study     run a twin study's shard (plant deviations x a sweep), its status, its merged analysis
   report    write a sweep's report: one self-contained HTML file and the points CSV
   token     create a bearer token for the daemon
 
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   if (command == "bench") return synbench::cli::bench_command(args);
   if (command == "profile") return synbench::cli::profile_command(args);
   if (command == "report") return synbench::cli::report_command(args);
+  if (command == "study") return synbench::cli::study_command(args);
   std::cerr << "synbench: unknown command '" << command << "' (see synbench --help)\n";
   return 2;
 }

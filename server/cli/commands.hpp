@@ -17,6 +17,7 @@ int bench_command(const std::vector<std::string>& args);
 int bench_check_command(const std::vector<std::string>& args);  // `bench check ...`, after "check"
 int profile_command(const std::vector<std::string>& args);
 int report_command(const std::vector<std::string>& args);
+int study_command(const std::vector<std::string>& args);
 
 extern const char* const kPointHelp;
 extern const char* const kConfigHelp;
@@ -27,5 +28,6 @@ extern const char* const kTokenHelp;
 extern const char* const kBenchHelp;
 extern const char* const kProfileHelp;
 extern const char* const kReportHelp;
+extern const char* const kStudyHelp;
 
 }  // namespace synbench::cli

@@ -299,23 +299,9 @@ int sweep_command(const std::vector<std::string>& argv) {
 
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_sigint);
-  const double tick_s = bench.poll_period_s;
-  double t = backend->clock().now_s();
-  bool abort_sent = false;
-  while (!run.finished()) {
-    if (g_interrupted && !abort_sent) {
-      run.engine().abort();
-      abort_sent = true;
-      if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
-    }
-    t += tick_s;
-    backend->clock().wait_until(t);
-    backend->tick(t);
-    supervisor.tick(t);
-    run.tick(t);
-  }
-  // However the sweep ended, the drives are read back stopped (or the alarm is raised).
-  app::confirm_stopped(*backend, supervisor, t, tick_s);
+  app::run_to_end(*backend, supervisor, run, bench.poll_period_s, [] { return g_interrupted.load(); }, [&] {
+    if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
+  });
   std::signal(SIGINT, previous);
   printer.finish_line();
 
