@@ -152,6 +152,22 @@ std::optional<double> regrouped_type_a(std::span<const double> batch_means) {
   return std::sqrt(std::max(0.0, a + b));
 }
 
+std::optional<double> position_bridge_type_a(std::span<const double> batch_speeds_rpm) {
+  const std::size_t n = batch_speeds_rpm.size();
+  if (n < 3) return std::nullopt;
+  const double B = static_cast<double>(n);
+  double mean = 0;
+  for (double x : batch_speeds_rpm) mean += x;
+  mean /= B;
+  double s = 0, ss = 0;  // running sum in units of rpm x tau, over k = 1 .. B-1
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    s += batch_speeds_rpm[k] - mean;
+    ss += s * s;
+  }
+  const double var_e = ss / (B - 1) / (1 + (2 * B - 1) / (3 * B));
+  return std::sqrt(2 * var_e) / B;
+}
+
 std::optional<double> type_a_of_mean(std::span<const double> batch_means) {
   const auto r = batch_type_a(batch_means);
   if (!r) return std::nullopt;
@@ -217,7 +233,18 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
   }
   static const drivers::SynrmWindow no_synrm;
   const drivers::SynrmWindow& sw = in.synrm ? *in.synrm : no_synrm;
-  {
+  if (sw.keeper == drivers::WindowKeeper::device) {
+    // The drive's window speed is an encoder count difference over the window: its error is the
+    // speed loop's position error at the two ends, not the batches' scatter (which the
+    // loop's integral action cancels over the window).
+    auto c = type_a("speed type A", "SynRM window's batch speeds, position bridge, GUM 4.2.3", "rpm",
+                    sw.batch_speed_meas_rpm, "the SynRM drive");
+    if (c.u) c.u = position_bridge_type_a(sw.batch_speed_meas_rpm);
+    if (!c.u) c.why = "the SynRM drive reports fewer than 3 batch speeds";
+    c.sensitivity[idx(Output::pm_W)] = c_n;
+    comps.push_back(std::move(c));
+  } else {
+    // A host-kept window's speed is a mean of polled speeds: no count difference to telescope.
     auto c = type_a("speed type A", "SynRM window's batch means, lag-1 (MA(1)) model, GUM 4.2.3", "rpm", sw.batch_speed_meas_rpm,
                     "the SynRM drive");
     c.sensitivity[idx(Output::pm_W)] = c_n;

@@ -44,7 +44,18 @@ std::optional<BatchTypeA> batch_type_a(std::span<const double> batch_means);
 // through the origin (u^2 = b). b < 0 (V falling with longer batches: positively correlated
 // batches) extrapolates upward. Fewer than two such G (B prime, B < 4): s / sqrt(B).
 std::optional<double> regrouped_type_a(std::span<const double> batch_means);
-// batch_type_a(...).u: the estimator every type A component of the budget uses.
+// The type A of a window's mean speed measured from encoder counts (the window's speed is
+// Delta-counts / T, each batch's the counts over its batch), under a speed loop with integral
+// action: the shaft's position error e against the reference is then bounded, each batch speed
+// is omega_ref + (e_k - e_(k-1)) / tau, and the window's mean errs by (e_B - e_0) / T only. The
+// running sum of the batch speeds' deviations from their mean is the bridge
+// S_k = e_k - e_0 - (k / B)(e_B - e_0); with e independent between batch ends (batches longer
+// than the loop's time constant), E[S_k^2] = var(e) (1 + (1 - k/B)^2 + (k/B)^2), so
+// var(e) = mean over k = 1..B-1 of S_k^2 / (1 + (2B - 1) / (3B)) and u = sqrt(2 var(e)) / T
+// (docs/uncertainty.md, "The speed"). In rpm, with S_k in rpm x tau: no time needed. Fewer than
+// 3 batches: unavailable.
+std::optional<double> position_bridge_type_a(std::span<const double> batch_speeds_rpm);
+// batch_type_a(...).u: the estimator every other type A component of the budget uses.
 std::optional<double> type_a_of_mean(std::span<const double> batch_means);
 
 // The currents of a VFC gate's equal sub-gates: I_b = (N_b / (T_g / B) - f0) / Kf.

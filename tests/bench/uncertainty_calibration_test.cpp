@@ -1,7 +1,8 @@
 // The reported type A against the truth of repetition: the thesis point (700 rpm, 2.5 N m,
 // 56 deg, encoder, CAPWM) and points of other character on the in-process twin, each under 30
-// noise seeds. The scatter of the record's pdcm_W, pm_W and im_A over the seeds against the RMS
-// of the type A the records report (their `_repeat` parts: the lag-1 batch estimator), against
+// noise seeds. The scatter of the record's pdcm_W, pm_W, im_A and speed_meas_rpm over the seeds
+// against the RMS of the type A the records report (their `_repeat` parts: the lag-1 batch
+// estimator, the speed's position bridge), against
 // the plain s / sqrt(B) of the same 10 batches, the regrouping fit of V(B) = a + b B over
 // B = 10, 5, 2, and the naive per-sample s / sqrt(N) (docs/uncertainty.md, "Calibration on the
 // twin").
@@ -145,7 +146,7 @@ struct Row {
 double spread(const std::vector<double>& u) { return sd(u) / rms(u); }  // SD over seeds / RMS
 
 std::vector<Row> calibrate(double speed_rpm, double load_Nm, double angle_deg) {
-  Series s[3];
+  Series s[4];
   for (int seed = 1; seed <= kSeeds; ++seed) {
     emulator::TwinConfig c;
     c.sim.seed_int = seed;
@@ -192,31 +193,37 @@ std::vector<Row> calibrate(double speed_rpm, double load_Nm, double angle_deg) {
     auto plain = [&](const std::string& n) { return batch_standard_error(batches(n)).value_or(0); };
     auto regroup = [&](const std::string& n) { return batches(n).empty() ? 0.0 : *regrouped_type_a(batches(n)); };
     const double wm = r.speed_meas_rpm * 2 * kPi / 60;
-    const double naive[3] = {
+    // The speed: its own component (a position bridge, not batch means: docs/uncertainty.md).
+    double u_speed = -1;
+    for (const auto& comp : b->components)
+      if (comp.name == "speed type A" && comp.u) u_speed = *comp.u;
+    EXPECT_GE(u_speed, 0) << "the budget has the speed's type A";
+    const double naive[4] = {
         r.udc_V * batch_standard_error(i_m1).value_or(0),
         std::hypot(wm * batch_standard_error(raw.lw.batch_torque_Nm).value_or(0),
                    (r.load_Nm + 2 * 2e-4 * wm) * 2 * kPi / 60 * batch_standard_error(raw.w.batch_speed_meas_rpm).value_or(0)),
-        batch_standard_error(raw.w.batch_im_A).value_or(0)};
-    const double value[3] = {r.pdcm_W, r.pm_W, r.im_A};
-    const double lag1[3] = {*r.pdcm_u_repeat_W, *b->u_repeat(Output::pm_W), *r.im_u_repeat_A};
+        batch_standard_error(raw.w.batch_im_A).value_or(0),
+        batch_standard_error(raw.w.batch_speed_meas_rpm).value_or(0)};
+    const double value[4] = {r.pdcm_W, r.pm_W, r.im_A, r.speed_meas_rpm};
+    const double lag1[4] = {*r.pdcm_u_repeat_W, *b->u_repeat(Output::pm_W), *r.im_u_repeat_A, u_speed};
     const Output out[3] = {Output::pdcm_W, Output::pm_W, Output::im_A};
-    for (int q = 0; q < 3; ++q) {
+    for (int q = 0; q < 4; ++q) {
       s[q].value.push_back(value[q]);
       s[q].lag1.push_back(lag1[q]);
-      s[q].plain.push_back(repeat_with(*b, out[q], plain));
-      s[q].regroup.push_back(repeat_with(*b, out[q], regroup));
+      s[q].plain.push_back(q < 3 ? repeat_with(*b, out[q], plain) : plain("speed type A"));
+      s[q].regroup.push_back(q < 3 ? repeat_with(*b, out[q], regroup) : regroup("speed type A"));
       s[q].naive.push_back(naive[q]);
     }
   }
   std::vector<Row> rows;
-  const char* names[3] = {"pdcm_W", "pm_W", "im_A"};
+  const char* names[4] = {"pdcm_W", "pm_W", "im_A", "speed_meas_rpm"};
   std::printf("%g rpm, %g N m, %g deg, %d seeds\n", speed_rpm, load_Nm, angle_deg, kSeeds);
-  for (int q = 0; q < 3; ++q) {
+  for (int q = 0; q < 4; ++q) {
     const Row row{names[q],          sd(s[q].value),        rms(s[q].lag1),    spread(s[q].lag1),
                   rms(s[q].plain),   spread(s[q].plain),    rms(s[q].regroup), spread(s[q].regroup),
                   rms(s[q].naive)};
     std::printf(
-        "  %-7s observed SD %.4g | lag-1 (reported) %.4g ratio %.3f spread %.2f | s/sqrt(B) %.4g ratio %.3f spread %.2f"
+        "  %-7s observed SD %.4g | reported %.4g ratio %.3f spread %.2f | s/sqrt(B) %.4g ratio %.3f spread %.2f"
         " | regroup %.4g ratio %.3f spread %.2f | naive %.4g ratio %.3f\n",
         row.name, row.obs, row.lag1, row.obs / row.lag1, row.lag1_spread, row.plain, row.obs / row.plain,
         row.plain_spread, row.regroup, row.obs / row.regroup, row.regroup_spread, row.naive, row.obs / row.naive);
@@ -254,22 +261,24 @@ void expect_agreement(const Row& row) {
   EXPECT_LE(row.lag1_spread, kMaxSpread) << row.name << ": the per-point estimate is noisier than the band allows";
 }
 
-// P_m: its speed component's batch means scatter far more than the window's mean speed (the
-// speed loop and the torque ripple exchange stored energy over more than one batch, which a
-// lag-1 model of 0.1 s batches does not see; docs/uncertainty.md): the reported type A stays
-// conservative, never optimistic, and at most 3 times.
-void expect_conservative(const Row& row) {
-  EXPECT_LE(row.obs / row.lag1, kHi) << row.name << ": the reported type A understates the scatter";
-  EXPECT_GT(row.obs / row.lag1, 1.0 / 3) << row.name << ": more than 3 times conservative";
-  EXPECT_LE(row.lag1_spread, kMaxSpread) << row.name;
-}
-
 void expect_calibrated(const std::vector<Row>& rows) {
-  ASSERT_EQ(rows.size(), 3u);
-  const Row &pdcm = find(rows, "pdcm_W"), &pm = find(rows, "pm_W"), &im = find(rows, "im_A");
+  ASSERT_EQ(rows.size(), 4u);
+  const Row &pdcm = find(rows, "pdcm_W"), &pm = find(rows, "pm_W"), &im = find(rows, "im_A"),
+            &speed = find(rows, "speed_meas_rpm");
   expect_agreement(pdcm);
   expect_agreement(im);
-  expect_conservative(pm);
+  expect_agreement(pm);
+  // The speed alone: its batch means scatter far more than the window's mean speed does (the
+  // speed loop's integral action cancels them over the window), so their s / sqrt(B) overstates
+  // it 4 to 7 times. The position bridge agrees at 300 rpm and stays conservative, never
+  // optimistic, at 700 and 1200 rpm (ratio 0.48 and 0.26): the speed ripple at the rotation's
+  // harmonics is counted in the position error at the batch ends, while a 1 s window spans
+  // (nearly) whole revolutions and cancels it. Its share of u(P_m) is then small enough that
+  // P_m agrees (above).
+  EXPECT_LE(speed.obs / speed.lag1, kHi) << "the speed's bridge understates the scatter";
+  EXPECT_GT(speed.obs / speed.lag1, 0.2) << "the speed's bridge more than 5 times conservative";
+  EXPECT_LE(speed.lag1_spread, kMaxSpread);
+  EXPECT_LT(speed.obs / speed.plain, speed.obs / speed.lag1) << "the bridge is closer than s / sqrt(B)";
   // The plain s / sqrt(B) of the same batches fails the band for P_dcM (by overstating): the
   // lag-1 model is what brings it in.
   EXPECT_LT(pdcm.obs / pdcm.plain, kLo) << "plain s / sqrt(B) of P_dcM";

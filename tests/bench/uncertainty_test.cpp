@@ -130,14 +130,16 @@ struct Spread {
   double rms_u, rms_se, sd_u_rel;
 };
 template <class Gen>
-Spread over_windows(Gen&& window, int windows) {
+Spread over_windows(Gen&& window, int windows,
+                    std::optional<double> (*estimator)(std::span<const double>) = type_a_of_mean) {
   double su2 = 0, sse2 = 0, su = 0;
   for (int i = 0; i < windows; ++i) {
     const std::vector<double> x = window();
-    const auto a = batch_type_a(x);
-    su2 += a->u * a->u;
-    su += a->u;
-    sse2 += a->standard_error * a->standard_error;
+    const double u = *estimator(x);
+    const double se = *batch_standard_error(x);
+    su2 += u * u;
+    su += u;
+    sse2 += se * se;
   }
   const double n = windows, mean_u = su / n, ms_u = su2 / n;
   return {std::sqrt(ms_u), std::sqrt(sse2 / n), std::sqrt(std::max(0.0, ms_u - mean_u * mean_u)) / std::sqrt(ms_u)};
@@ -279,16 +281,50 @@ TEST(Uncertainty, TypeAComesFromTheBatchScatterAndPropagatesThroughUdc) {
   EXPECT_NEAR(*b.u_repeat(Output::efficiency), *b.u(Output::efficiency), 1e-15);
 }
 
+TEST(Uncertainty, TheEncoderSpeedsTypeAIsThePositionErrorAtTheWindowsEnds) {
+  // Hand-computed: B = 4, deviations -1, +1, -1, +1: running sums -1, 0, -1, so var(e) =
+  // (2 / 3) / (1 + 7 / 12) = 8 / 19 and u = sqrt(2 x 8 / 19) / 4.
+  const std::vector<double> alternating{699, 701, 699, 701};
+  ASSERT_TRUE(position_bridge_type_a(alternating));
+  EXPECT_NEAR(*position_bridge_type_a(alternating), std::sqrt(16.0 / 19.0) / 4.0, 1e-12);
+  EXPECT_FALSE(position_bridge_type_a(std::vector<double>{700, 701}));
+  EXPECT_EQ(*position_bridge_type_a(std::vector<double>(10, 700.0)), 0.0);
+  // Speeds that are position differences of a bounded error e (independent at the batch ends,
+  // SD 1 count-equivalent): the window mean's SD is sqrt(2) / B; the bridge finds it, where
+  // s / sqrt(B) overstates by about sqrt(B).
+  std::mt19937 rng(17);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const auto s = over_windows(
+      [&] {
+        std::vector<double> x(10);
+        double prev = e(rng);
+        for (auto& v : x) {
+          const double next = e(rng);
+          v = 700 + next - prev;
+          prev = next;
+        }
+        return x;
+      },
+      20000, position_bridge_type_a);
+  const double truth = std::sqrt(2.0) / 10;
+  std::printf("bridge: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u, s.rms_se, truth,
+              s.sd_u_rel);
+  EXPECT_NEAR(s.rms_u / truth, 1.0, 0.05);
+  EXPECT_GT(s.rms_se / truth, 3.0);
+}
+
 TEST(Uncertainty, ShaftPowerAndEfficiencyFromTorqueSpeedAndFriction) {
   Point p;
   auto cfg = zero_config();
   cfg.torque_gain_u_pct = 1.0;       // 0.025 N m
   cfg.load_b1_u_Nms_per_rad = 5e-5;  // x w^2
-  p.w.batch_speed_meas_rpm = {699, 701, 699, 701};  // u = sqrt(8/15) / 4 = 0.18257 rpm
+  // A device window's speed: the position bridge. Running sums -1, 0, -1 (k = 1..3): var(e) =
+  // (2 / 3) / (1 + 7 / 12) = 8 / 19, u = sqrt(16 / 19) / 4 = 0.22942 rpm.
+  p.w.batch_speed_meas_rpm = {699, 701, 699, 701};
   const auto b = point_budget(p.in, cfg);
   const double wm = 700 * 2 * kPi / 60;
   const double u_T = 0.025 * wm, u_b1 = 5e-5 * wm * wm;
-  const double u_n = std::sqrt(8.0 / 15.0) / 4.0 * (2.5 + 2 * 2e-4 * wm) * 2 * kPi / 60;
+  const double u_n = std::sqrt(16.0 / 19.0) / 4.0 * (2.5 + 2 * 2e-4 * wm) * 2 * kPi / 60;
   ASSERT_TRUE(b.u(Output::pm_W));
   EXPECT_NEAR(*b.u(Output::pm_W), std::sqrt(u_T * u_T + u_b1 * u_b1 + u_n * u_n), 1e-9);
   EXPECT_NEAR(*b.u_repeat(Output::pm_W), u_n, 1e-9);  // gains and B1G are systematic
