@@ -70,7 +70,17 @@ PgCluster* PgCluster::shared() {
       (void)run(std::string(SYNBENCH_PG_CLUSTER_SCRIPT) + " stop " + quoted(dir));
       return nullptr;
     }
-    return std::unique_ptr<PgCluster>(new PgCluster(dir, std::stoi(o.text)));
+    // The port from the file the script writes, not its output: run as `nobody` from a directory
+    // nobody may enter (a fresh clone under a private mktemp directory), PostgreSQL's tools print
+    // "could not change directory" warnings there, before the port.
+    std::ifstream port_file(dir + "/port");
+    int port = 0;
+    if (!(port_file >> port)) {
+      error_text() = "the PostgreSQL test cluster started but wrote no port to " + dir + "/port: " + o.text;
+      (void)run(std::string(SYNBENCH_PG_CLUSTER_SCRIPT) + " stop " + quoted(dir));
+      return nullptr;
+    }
+    return std::unique_ptr<PgCluster>(new PgCluster(dir, port));
   }();
   return cluster.get();
 }

@@ -30,6 +30,10 @@ case "$cmd" in
 start)
   bin=$(bindir)
   mkdir -p "$dir"
+  # Absolute, then run from /: the cluster's user may not enter the caller's directory (a fresh
+  # clone under a private mktemp directory), and PostgreSQL's tools warn about that on stderr.
+  dir=$(cd "$dir" && pwd)
+  cd /
   if [ "$(id -u)" = 0 ]; then chown nobody "$dir"; fi
   chmod 700 "$dir"
   as_owner test -w "$dir" ||
