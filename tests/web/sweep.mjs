@@ -159,7 +159,8 @@ try {
 
   // ---- 6: an adaptive sweep's cells, one row per curve, no holes ----
   const a = (await rest(daemon.url, 'POST', '/api/sweeps', token, quick('adaptive', { mode: 'adaptive',
-    adaptive: { bracket_deg: [40, 70], tolerance_deg: 4, max_evaluations: 6, stencil_deg: 6 },
+    adaptive: { bracket_deg: [40, 70], tolerance_deg: 4, max_evaluations: 6, stencil_deg: 6, angle_u_target_deg: 45 },
+    precision: { mode: 'lengthen', pdcm_u_repeat_target_W: 1000, max_window_s: 0.4 },
     dimensions: { speed_rpm: [300, 600], load_Nm: [1], configurations: [{ estimator: 'encoder', pwm: 'capwm' }] } }))).json;
   check(a?.id, `an adaptive sweep is created (${a?.total_points} points at most)`);
   const aEst = (await rest(daemon.url, 'POST', '/api/sweeps/estimate', token, a.plan)).json;
@@ -180,6 +181,33 @@ try {
   const row = await page.evaluate(() => document.activeElement?.closest('.cellrow')?.getAttribute('aria-label'));
   check(/600 rpm/.test(row || ''), `ArrowDown moves to the next curve's row (${row})`);
   await shot(page, artifacts, 'sweep-07-adaptive');
+
+  // ---- 6b: measure until sure: the Results view tells the sweep's outcome, the builder sets it ----
+  const oc = (await rest(daemon.url, 'GET', `/api/sweeps/${a.id}/analysis`, token)).json?.sweep_outcome;
+  check(oc?.adaptive && oc?.precision, `the analysis carries the sweep's outcome (${JSON.stringify(oc?.adaptive?.points_used)} points used)`);
+  await page.goto(`${origin.url}#/results/${a.id}`);
+  const wantOutcome = `Measure until sure: adaptive search: ${oc.adaptive.points_used} points used against ${oc.adaptive.grid_points} on the ${oc.adaptive.grid_step_deg}° grid; `
+    + `angle u target 45° met on ${oc.adaptive.curves_target_met} of ${oc.adaptive.curves.length} curves; `
+    + `P_dcM u target 1000 W: ${oc.precision.points_missed} of ${oc.precision.points} points above it.`;
+  check(await until(async () => (await text(page, '#r-outcome')) === wantOutcome, 15000),
+    `the Results view tells the outcome from the analysis: "${await text(page, '#r-outcome')}"`);
+  check(oc.adaptive.points_used === sa.points_stored && oc.adaptive.grid_points === 2 * 16 && oc.precision.points === sa.points_stored,
+    `the outcome counts the stored points against the 2° grid over 40..70 (16 angles per curve): ${oc.adaptive.points_used} of ${oc.adaptive.grid_points}`);
+  await page.goto(`${origin.url}#/sweep`);
+  await page.check('input[name="b-mode"][value="adaptive"]');
+  await page.fill('#b-angle-u', '0.5');
+  await page.fill('#b-pdcm-u', '0.05');
+  await page.fill('#b-max-window', '4');
+  const built = JSON.parse(await text(page, '#b-json'));
+  check(built.adaptive?.angle_u_target_deg === 0.5 && JSON.stringify(built.precision) === JSON.stringify({ mode: 'lengthen', pdcm_u_repeat_target_W: 0.05, max_window_s: 4 }),
+    `the builder's targets reach the plan (${JSON.stringify({ angle_u_target_deg: built.adaptive?.angle_u_target_deg, precision: built.precision })})`);
+  const builtEst = (await rest(daemon.url, "POST", "/api/sweeps/estimate", token, built)).json;
+  check(builtEst?.upper_bound === true && builtEst.precision_extra_s > 0, `the daemon accepts the built plan and estimates an upper bound (${builtEst?.precision_extra_s} s for lengthening)`);
+  await page.fill('#b-pdcm-u', '');
+  await page.fill('#b-angle-u', '');
+  const cleared = JSON.parse(await text(page, '#b-json'));
+  check(!('precision' in cleared) && !('angle_u_target_deg' in (cleared.adaptive || {})), 'empty targets leave them out of the plan');
+  await page.check('input[name="b-mode"][value="grid"]');
 
   // ---- 5: a sweep cut by a daemon stop says why ----
   const r = (await rest(daemon.url, 'POST', '/api/sweeps', token, quick('cut by a stop'))).json;

@@ -24,3 +24,20 @@ export function uncertaintyNote(points, analysis) {
   return `Uncertainty (GUM, docs/uncertainty.md): ${withU} of ${points.length} points carry u; bars show ±2u (95 %), tooltips value ± u (k=1)`
     + `${parts.length ? `; ${parts.join('; ')} (at 95 %)` : ''}.`;
 }
+
+// The sweep's "measure until sure" outcome (analysis.sweep_outcome, docs/sweep-plan.md): how many
+// points the adaptive searches used against the 2-deg grid's, how many curves met the angle u
+// target, and how many points stayed above the precision target; '' when the plan had neither.
+export function outcomeNote(outcome) {
+  const parts = [];
+  const a = outcome?.adaptive;
+  if (a) {
+    parts.push(`adaptive search: ${a.points_used} points used against ${a.grid_points} on the ${a.grid_step_deg}° grid`);
+    if (a.angle_u_target_deg != null) {
+      parts.push(`angle u target ${a.angle_u_target_deg}° met on ${a.curves_target_met} of ${(a.curves || []).length} curves`);
+    }
+  }
+  const p = outcome?.precision;
+  if (p) parts.push(`P_dcM u target ${p.pdcm_u_repeat_target_W} W: ${p.points_missed} of ${p.points} points above it`);
+  return parts.length ? `Measure until sure: ${parts.join('; ')}.` : '';
+}

@@ -3,7 +3,7 @@ import { api, download, saveBlob, getToken } from '../api.js';
 import { ChartCard } from '../charts.js';
 import { analysisConfigs } from '../analysis_configs.js';
 import { effMapOption, etaOption, trajectoriesOption, curveOption, posErrOption, deltaOption, histOption, cfgLabel } from './plots.js';
-import { uncertaintyNote } from '../uncertainty_note.js';
+import { uncertaintyNote, outcomeNote } from '../uncertainty_note.js';
 import { escapeHtml } from './live.js';
 import { onBench } from '../bench_label.js';
 import { ResultTables } from './tables.js';
@@ -125,6 +125,9 @@ export class ResultsView {
       $('#r-summary').textContent = `Sweep #${id}: ${p.records ?? points.length} points, ${p.used ?? '?'} used`
         + `${p.excluded?.length ? `, ${p.excluded.length} left out (unstable, faulted or voltage-limited)` : ''}`;
       $('#r-unote').textContent = uncertaintyNote(points, analysis);
+      const outcome = outcomeNote(analysis?.sweep_outcome);
+      $('#r-outcome').hidden = !outcome;
+      $('#r-outcome').textContent = outcome;
     } catch (e) {
       $('#r-summary').textContent = `cannot load sweep ${id}: ${e.message}`;
     }

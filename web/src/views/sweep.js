@@ -204,6 +204,9 @@ export class SweepView {
     $('#b-tol').value = a.tolerance_deg ?? 1;
     $('#b-maxev').value = a.max_evaluations ?? 7;
     $('#b-stencil').value = a.stencil_deg ?? 6;
+    $('#b-angle-u').value = a.angle_u_target_deg ?? '';
+    $('#b-pdcm-u').value = plan.precision?.pdcm_u_repeat_target_W ?? '';
+    $('#b-max-window').value = plan.precision?.max_window_s ?? 8;
     $('#b-window').value = plan.window_s ?? 1;
     $('#b-span').value = plan.gate?.span_s ?? 0.5;
     $('#b-settle').value = plan.gate?.min_settle_s ?? 0.5;
@@ -244,6 +247,9 @@ export class SweepView {
     if (plan.mode === 'adaptive') {
       plan.adaptive = { ...(plan.adaptive || {}), bracket_deg: [Number($('#b-br-from').value), Number($('#b-br-to').value)],
         tolerance_deg: Number($('#b-tol').value), max_evaluations: Number($('#b-maxev').value), stencil_deg: Number($('#b-stencil').value) };
+      const angleU = $('#b-angle-u').value.trim();
+      if (angleU !== '') plan.adaptive.angle_u_target_deg = Number(angleU);
+      else delete plan.adaptive.angle_u_target_deg;
     } else {
       delete plan.adaptive;
     }
@@ -251,6 +257,10 @@ export class SweepView {
     plan.gate = { ...(plan.gate || {}), span_s: Number($('#b-span').value), min_settle_s: Number($('#b-settle').value), timeout_s: Number($('#b-timeout').value),
       average_s: Number($('#b-average').value) };
     plan.thermal = { ...(plan.thermal || {}), enabled: $('#b-thermal').checked };
+    // Measure until sure (docs/sweep-plan.md, "precision"): only when a target is given.
+    const pdcmU = $('#b-pdcm-u').value.trim();
+    if (pdcmU !== '') plan.precision = { mode: 'lengthen', pdcm_u_repeat_target_W: Number(pdcmU), max_window_s: Number($('#b-max-window').value) };
+    else delete plan.precision;
     return plan;
   }
 
