@@ -5,6 +5,7 @@
 #include <chrono>
 #include <ctime>
 #include <stdexcept>
+#include <thread>
 
 #include "db/backend.hpp"
 #include "db/bench_identity.hpp"
@@ -250,7 +251,16 @@ Result<std::unique_ptr<Backend>> open_sqlite(const std::filesystem::path& path, 
   {
     auto st = Statement::prepare(impl->db, "PRAGMA journal_mode = WAL");
     if (!st) return refuse(Error{st.error().code, where + ": " + st.error().message});
-    const int step = st->step();
+    // Two processes switching a new file to WAL at once: SQLite answers SQLITE_BUSY to one of
+    // them without calling the busy handler (it would deadlock on the lock upgrade), so the wait
+    // busy_timeout promises is kept here (several study shards opening one new file).
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(options.busy_timeout_ms);
+    int step = st->step();
+    while ((step == SQLITE_BUSY || step == SQLITE_LOCKED) && std::chrono::steady_clock::now() < give_up) {
+      st->reset();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      step = st->step();
+    }
     if (step != SQLITE_ROW) return refuse(sqlite_error(impl->db, step, where + ": setting WAL"));
     if (st->text(0) != "wal")
       return make_error(errc::io, where + ": WAL journal not available (got \"" + st->text(0) + "\")");
