@@ -274,22 +274,15 @@ class PgBackend final : public Backend {
       if (auto e = exists(*sweep_id); !e) return e.error();
       p.bind(1, *sweep_id);
     }
-    auto r = sweep_id ? c_.exec("SELECT id, sweep_id, at, kind, message FROM events WHERE sweep_id = $1 ORDER BY id", p,
-                                "reading events")
-                      : c_.exec("SELECT id, sweep_id, at, kind, message FROM events ORDER BY id", "reading events");
+    const std::string columns(detail::kEventColumns);
+    auto r = sweep_id ? c_.exec(columns + " WHERE sweep_id = $1 ORDER BY id", p, "reading events")
+                      : c_.exec(columns + " ORDER BY id", "reading events");
     if (!r) return fail(r.error());
     std::vector<Event> out;
     for (int i = 0; i < PQntuples(r->get()); ++i) {
-      const PgRow row(r->get(), i);
-      Event e;
-      e.id = row.integer(0);
-      if (!row.is_null(1)) e.sweep_id = row.integer(1);
-      e.at = row.text(2);
-      const auto kind = parse_event_kind(row.text(3));
-      if (!kind) return make_error(errc::bad_record, "event " + std::to_string(e.id) + " has an unknown kind");
-      e.kind = *kind;
-      e.message = row.text(4);
-      out.push_back(std::move(e));
+      auto e = detail::read_event(PgRow(r->get(), i));
+      if (!e) return e.error();
+      out.push_back(std::move(*e));
     }
     return out;
   }

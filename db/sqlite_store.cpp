@@ -113,9 +113,8 @@ class SqliteBackend final : public Backend {
         {&insert_point_st, insert_point_sql()},
         {&select_points, select_points_sql()},
         {&select_indices, "SELECT point_index FROM points WHERE sweep_id = ? ORDER BY point_index"},
-        {&select_events_of_sweep,
-         "SELECT id, sweep_id, at, kind, message FROM events WHERE sweep_id = ? ORDER BY id"},
-        {&select_events_all, "SELECT id, sweep_id, at, kind, message FROM events ORDER BY id"},
+        {&select_events_of_sweep, std::string(kEventColumns) + " WHERE sweep_id = ? ORDER BY id"},
+        {&select_events_all, std::string(kEventColumns) + " ORDER BY id"},
         {&select_running, std::string(kRunningSql)},
     };
     for (const auto& [st, sql] : all) {
@@ -537,15 +536,9 @@ Result<std::vector<Event>> SqliteBackend::events(std::optional<std::int64_t> swe
     const int rc = st.step();
     if (rc == SQLITE_DONE) return out;
     if (rc != SQLITE_ROW) return d.fail(rc, "reading events");
-    Event e;
-    e.id = st.integer(0);
-    if (!st.is_null(1)) e.sweep_id = st.integer(1);
-    e.at = st.text(2);
-    const auto kind = parse_event_kind(st.text(3));
-    if (!kind) return make_error(errc::bad_record, "event " + std::to_string(e.id) + " has an unknown kind");
-    e.kind = *kind;
-    e.message = st.text(4);
-    out.push_back(std::move(e));
+    auto e = detail::read_event(st);
+    if (!e) return e.error();
+    out.push_back(std::move(*e));
   }
 }
 

@@ -1,6 +1,6 @@
 // What both backends share besides the schema: the SQL of their statements (SQLite's `?`
 // placeholders, turned into PostgreSQL's `$n` by pg_sql()), a sweep read back from a row of
-// kSweepColumns, and the rules of a sweep's state changes. Internal to db/.
+// kSweepColumns and an event from one of kEventColumns, and the rules of a sweep's state changes. Internal to db/.
 #pragma once
 
 #include <cstdint>
@@ -82,6 +82,22 @@ Result<Sweep> read_sweep(const Row& st) {
   }
   s.meta.key = st.opt_text(17);
   return s;
+}
+
+inline constexpr std::string_view kEventColumns = "SELECT id, sweep_id, at, kind, message FROM events";
+
+// An event from a row of kEventColumns (a SQLite statement or a PostgreSQL row).
+template <class Row>
+Result<Event> read_event(const Row& st) {
+  Event e;
+  e.id = st.integer(0);
+  if (!st.is_null(1)) e.sweep_id = st.integer(1);
+  e.at = st.text(2);
+  const auto kind = parse_event_kind(st.text(3));
+  if (!kind) return make_error(errc::bad_record, "event " + std::to_string(e.id) + " has an unknown kind");
+  e.kind = *kind;
+  e.message = st.text(4);
+  return e;
 }
 
 // The parameters of kInsertSweepSql, with the store's bench identity where the sweep has none.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "app/report/report_text.hpp"
 #include "app/report/svg_plot.hpp"
 #include "drivers/json.hpp"
 
@@ -25,18 +26,6 @@ const Json& member(const Json& j, const char* key) {
   const auto it = j.find(key);
   return it == j.end() ? kNull : *it;
 }
-std::string fixed(double v, int decimals) {
-  if (!std::isfinite(v)) return "–";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-std::string shortest(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-std::string td(const std::string& s) { return "<td>" + escape_xml(s) + "</td>"; }
 std::string str(const Json& j, const char* key) {
   const auto& v = member(j, key);
   return v.is_string() ? v.get<std::string>() : std::string();

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "app/report/report_uncertainty.hpp"
+#include "app/report/report_text.hpp"
 #include "app/report/svg_plot.hpp"
 #include "bench/efficiency_grid.hpp"
 #include "db/export.hpp"
@@ -26,18 +27,6 @@ namespace {
 using bench::Configuration;
 using bench::label;
 
-std::string fixed(double v, int decimals) {
-  if (!std::isfinite(v)) return "–";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-std::string shortest(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-std::string td(const std::string& s) { return "<td>" + escape_xml(s) + "</td>"; }
 bool same(double a, double b) { return std::fabs(a - b) < 1e-6; }
 
 struct Page {

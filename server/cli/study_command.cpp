@@ -96,6 +96,22 @@ std::optional<db::Store> open_store(const std::string& target) {
   return std::move(*opened);
 }
 
+// The store with the study's sweeps in it (sample index -> sweep), or nothing after saying why.
+struct StudyInStore {
+  db::Store store;
+  std::map<std::size_t, db::Sweep> sweeps;
+};
+std::optional<StudyInStore> open_study(const bench::StudyPlan& plan, const std::string& db_target) {
+  auto store = open_store(db_target);
+  if (!store) return std::nullopt;
+  auto sweeps = app::study_sweeps(*store, plan);
+  if (!sweeps) {
+    std::cerr << "synbench study: " << sweeps.error().message << "\n";
+    return std::nullopt;
+  }
+  return StudyInStore{std::move(*store), std::move(*sweeps)};
+}
+
 int run(const bench::StudyPlan& plan, bench::Shard shard, const std::string& db_target,
         const emulator::TwinConfig& nominal, bool dry_run, bool quiet) {
   const auto mine = bench::shard_samples(plan, shard);
@@ -147,13 +163,9 @@ int run(const bench::StudyPlan& plan, bench::Shard shard, const std::string& db_
 }
 
 int status(const bench::StudyPlan& plan, const std::string& db_target, std::size_t shards, bool as_json) {
-  auto store = open_store(db_target);
-  if (!store) return 1;
-  auto sweeps = app::study_sweeps(*store, plan);
-  if (!sweeps) {
-    std::cerr << "synbench study: " << sweeps.error().message << "\n";
-    return 1;
-  }
+  auto study = open_study(plan, db_target);
+  if (!study) return 1;
+  const auto& sweeps = study->sweeps;
   struct Counts {
     std::size_t samples = 0, done = 0, running = 0, stopped = 0, missing = 0;
     std::int64_t points = 0;
@@ -162,8 +174,8 @@ int status(const bench::StudyPlan& plan, const std::string& db_target, std::size
   for (std::size_t i = 0; i < bench::sample_count(plan); ++i) {
     Counts& c = per[i % shards];
     ++c.samples;
-    const auto it = sweeps->find(i);
-    if (it == sweeps->end()) {
+    const auto it = sweeps.find(i);
+    if (it == sweeps.end()) {
       ++c.missing;
       continue;
     }
@@ -197,16 +209,13 @@ int status(const bench::StudyPlan& plan, const std::string& db_target, std::size
 
 int analyse(const bench::StudyPlan& plan, const std::string& db_target, const std::optional<std::string>& json_out,
             std::size_t bins) {
-  auto store = open_store(db_target);
-  if (!store) return 1;
-  auto sweeps = app::study_sweeps(*store, plan);
-  if (!sweeps) {
-    std::cerr << "synbench study: " << sweeps.error().message << "\n";
-    return 1;
-  }
+  auto study = open_study(plan, db_target);
+  if (!study) return 1;
+  auto& store = study->store;
+  const auto& sweeps = study->sweeps;
   std::vector<bench::StudySampleRecords> samples;
-  for (const auto& [i, sweep] : *sweeps) {
-    auto rows = store->points(sweep.id);
+  for (const auto& [i, sweep] : sweeps) {
+    auto rows = store.points(sweep.id);
     if (!rows) {
       std::cerr << "synbench study: " << rows.error().message << "\n";
       return 1;

@@ -116,6 +116,15 @@ export async function stopDaemon(d, signal = 'SIGTERM') {
   return code;
 }
 
+// A test's end, whatever happened: the browser and the page's origin closed, the daemon sent
+// SIGTERM and checked to exit 0 (its ordered stop and store close went well).
+export async function tearDown({ browser, origin, daemon }) {
+  await browser.close();
+  await origin.stop();
+  const code = await stopDaemon(daemon);
+  check(code === 0, `the daemon exits 0 on SIGTERM (${code})`);
+}
+
 const helpCache = new Map();
 async function helpMentions(bin, word) {
   if (!helpCache.has(bin)) {

@@ -13,7 +13,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import {
   args, loadPlaywright, launch, check, finish, until, shot, tmpDir, startDaemon, stopDaemon, pageOrigin,
-  signIn, text, attr, log, rest,
+  signIn, text, attr, log, rest, tearDown,
 } from './harness.mjs';
 
 const { bin, webDir, artifacts } = args();
@@ -179,10 +179,7 @@ try {
 } catch (e) {
   check(false, `unexpected error: ${e.stack || e}`);
 } finally {
-  await browser.close();
-  await origin.stop();
-  const code = await stopDaemon(daemon);
-  check(code === 0, `the daemon exits 0 on SIGTERM (${code})`);
+  await tearDown({ browser, origin, daemon });
   log('done');
 }
 finish();

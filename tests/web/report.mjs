@@ -9,8 +9,8 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import {
-  args, loadPlaywright, launch, check, finish, until, tmpDir, startDaemon, stopDaemon, pageOrigin,
-  signIn, text, attr, log, rest,
+  args, loadPlaywright, launch, check, finish, until, tmpDir, startDaemon, pageOrigin,
+  signIn, text, attr, log, rest, tearDown,
 } from './harness.mjs';
 
 const { bin, webDir, artifacts } = args();
@@ -97,8 +97,6 @@ try {
 } catch (e) {
   check(false, `unexpected error: ${e.stack || e}`);
 } finally {
-  await browser.close();
-  await origin.stop();
-  await stopDaemon(daemon);
+  await tearDown({ browser, origin, daemon });
 }
 finish();
