@@ -4,8 +4,9 @@
   stored, ids distinct, each sweep with its own bench name, host and the twin's devices;
 - a writer killed (SIGKILL) mid-sweep, resumed with `--resume`: it restarts at its first missing
   point, every index once;
-- `synbench serve --db postgresql://...`: a sweep created, run and read back over REST, and the
-  same points read from PostgreSQL directly with psql; `synbench report --db` on it;
+- two `synbench serve --db postgresql://...` daemons as two benches, each running a sweep over REST
+  at the same time: both complete, each sweep under its own bench, read back over REST and with
+  psql alike, and either daemon's history lists both benches' runs; `synbench report --db` on one;
 - `synbench sweep --bench` over Modbus TCP against `synbench emulate`: the sweep carries the bench
   config's profiles, by name, with their content versions;
 - a password in the URL is never printed by sweep, serve or report.
@@ -129,39 +130,56 @@ def killed_and_resumed(work, sock, port, url):
 
 
 def served(work, sock, port, url):
-    data_dir = os.path.join(work, "served")
-    d = Daemon(BIN, data_dir, extra_args=["--db", url, "--bench-name", "served-bench"])
+    """Two daemons, two benches, one lab store: each runs a sweep over REST at the same time."""
+    benches = ("served-bench", "served-bench-2")
+    daemons = []
     try:
-        s, body = d.request("POST", "/api/sweeps", {
-            "name": "over rest", "window_s": 0.2,
-            "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 50, 56]}})
-        check(s == 201, "POST /api/sweeps -> 201 (%s)" % body)
-        sid = body["id"]
-        s, body = d.request("POST", "/api/sweeps/%d/start" % sid)
-        check(s == 202, "start -> 202 (%s)" % body)
-        done = wait_for(lambda: d.request("GET", "/api/sweeps/%d" % sid)[1].get("state") == "completed", 180, 0.5)
-        check(done, "the served sweep completes (%s)" % (d.request("GET", "/api/sweeps/%d" % sid),))
-        s, pts = d.request("GET", "/api/sweeps/%d/points" % sid)
-        items = pts["points"] if isinstance(pts, dict) and "points" in pts else pts
-        check(s == 200 and len(items) == 3, "three points over REST (%s)" % str(pts)[:300])
-        rest_im = sorted(float(p["im_A"]) for p in items)
-        db_im = sorted(float(x) for x in psql(
-            sock, port, "lab", "SELECT im_a FROM points WHERE sweep_id = %d" % sid).splitlines())
-        check(rest_im == db_im, "REST and psql read the same points (%s vs %s)" % (rest_im, db_im))
-        who = psql(sock, port, "lab", "SELECT bench_name FROM sweeps WHERE id = %d" % sid)
-        check(who == "served-bench", "the served sweep carries the daemon's bench name (%s)" % who)
-        _, sweep = d.request("GET", "/api/sweeps/%d" % sid)
-        check(sweep.get("bench", {}).get("name") == "served-bench" and len(sweep["bench"]["devices"]) == 3 and
-              sweep.get("key") is None, "GET /api/sweeps/{id} gives the bench's identity (%s)" % sweep.get("bench"))
-        check(not os.path.exists(os.path.join(data_dir, "synbench.db")), "no SQLite file beside: the store is PostgreSQL")
+        for name in benches:
+            daemons.append(Daemon(BIN, os.path.join(work, name), extra_args=["--db", url, "--bench-name", name]))
+        sids = []
+        for k, d in enumerate(daemons):
+            s, body = d.request("POST", "/api/sweeps", {
+                "name": "over rest %d" % k, "window_s": 0.2,
+                "dimensions": {"speed_rpm": [500], "load_Nm": [1.0], "angle_deg": [44, 50, 56]}})
+            check(s == 201, "daemon %d: POST /api/sweeps -> 201 (%s)" % (k, body))
+            sids.append(body["id"])
+        check(len(set(sids)) == 2, "the two daemons' sweeps have distinct ids in the one store (%s)" % sids)
+        for k, (d, sid) in enumerate(zip(daemons, sids)):
+            s, body = d.request("POST", "/api/sweeps/%d/start" % sid)
+            check(s == 202, "daemon %d: start -> 202 (%s)" % (k, body))
+        for k, (d, sid) in enumerate(zip(daemons, sids)):
+            done = wait_for(lambda: d.request("GET", "/api/sweeps/%d" % sid)[1].get("state") == "completed", 180, 0.5)
+            check(done, "daemon %d: its sweep completes while the other writes (%s)" % (k, d.request("GET", "/api/sweeps/%d" % sid),))
+        for k, (d, sid) in enumerate(zip(daemons, sids)):
+            s, pts = d.request("GET", "/api/sweeps/%d/points" % sid)
+            items = pts["points"] if isinstance(pts, dict) and "points" in pts else pts
+            check(s == 200 and len(items) == 3, "daemon %d: three points over REST (%s)" % (k, str(pts)[:300]))
+            rest_im = sorted(float(p["im_A"]) for p in items)
+            db_im = sorted(float(x) for x in psql(
+                sock, port, "lab", "SELECT im_a FROM points WHERE sweep_id = %d" % sid).splitlines())
+            check(rest_im == db_im, "daemon %d: REST and psql read the same points (%s vs %s)" % (k, rest_im, db_im))
+            who = psql(sock, port, "lab", "SELECT bench_name FROM sweeps WHERE id = %d" % sid)
+            check(who == benches[k], "daemon %d: its sweep carries its own bench name (%s)" % (k, who))
+            _, sweep = d.request("GET", "/api/sweeps/%d" % sid)
+            check(sweep.get("bench", {}).get("name") == benches[k] and len(sweep["bench"]["devices"]) == 3 and
+                  sweep.get("key") is None, "daemon %d: GET /api/sweeps/{id} gives the bench's identity (%s)" % (k, sweep.get("bench")))
+            check(not os.path.exists(os.path.join(work, benches[k], "synbench.db")),
+                  "daemon %d: no SQLite file beside: the store is PostgreSQL" % k)
+        # The lab's history: either daemon lists both benches' runs, each under its bench.
+        for k, d in enumerate(daemons):
+            s, history = d.request("GET", "/api/sweeps")
+            by_id = {h["id"]: (h.get("bench") or {}).get("name") for h in history}
+            check(s == 200 and [by_id.get(sid) for sid in sids] == list(benches),
+                  "daemon %d's history holds both benches' sweeps under their names (%s)" % (k, by_id))
         out = os.path.join(work, "report")
-        r = subprocess.run([BIN, "report", str(sid), "--db", url, "--out", out], capture_output=True, text=True, timeout=120)
+        r = subprocess.run([BIN, "report", str(sids[0]), "--db", url, "--out", out], capture_output=True, text=True, timeout=120)
         check(r.returncode == 0 and any(f.endswith(".html") for f in os.listdir(out)),
               "synbench report --db postgresql://... writes the report (%s)" % r.stderr[-300:])
         check(SECRET not in r.stdout + r.stderr, "report never prints the password")
     finally:
-        _, err = d.stop()
-        check(SECRET not in (err or ""), "serve never prints or logs the password")
+        for d in daemons:
+            _, err = d.stop()
+            check(SECRET not in (err or ""), "serve never prints or logs the password")
 
 
 def over_modbus(work, sock, port, url):
