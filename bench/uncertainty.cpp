@@ -14,19 +14,21 @@ constexpr double kRadPerRpm = 2.0 * kPi / 60.0;
 
 constexpr std::size_t idx(Output o) { return static_cast<std::size_t>(o); }
 
-// A type A component from batch means, or unavailable with the reason.
+// A type A component from batch means by `estimate` (which needs `min_batches` of them), or
+// unavailable with the reason.
 BudgetComponent type_a(std::string name, std::string source, std::string unit, const std::vector<double>& batches,
-                       const char* device) {
+                       const char* device, std::optional<double> (*estimate)(std::span<const double>) = type_a_of_mean,
+                       std::size_t min_batches = 2) {
   BudgetComponent c;
   c.name = std::move(name);
   c.type = 'A';
   c.source = std::move(source);
   c.unit = std::move(unit);
   c.repeat = true;
-  c.u = type_a_of_mean(batches);
+  c.u = estimate(batches);
   if (!c.u)
     c.why = batches.empty() ? std::string(device) + " reports no batch means"
-                            : std::string(device) + " reports fewer than 2 batch means";
+                            : std::string(device) + " reports fewer than " + std::to_string(min_batches) + " batch means";
   return c;
 }
 
@@ -238,9 +240,7 @@ PointBudget point_budget(const BudgetInputs& in, const drivers::UncertaintyConfi
     // speed loop's position error at the two ends, not the batches' scatter (which the
     // loop's integral action cancels over the window).
     auto c = type_a("speed type A", "SynRM window's batch speeds, position bridge, GUM 4.2.3", "rpm",
-                    sw.batch_speed_meas_rpm, "the SynRM drive");
-    if (c.u) c.u = position_bridge_type_a(sw.batch_speed_meas_rpm);
-    if (!c.u) c.why = "the SynRM drive reports fewer than 3 batch speeds";
+                    sw.batch_speed_meas_rpm, "the SynRM drive", position_bridge_type_a, 3);
     c.sensitivity[idx(Output::pm_W)] = c_n;
     comps.push_back(std::move(c));
   } else {

@@ -125,6 +125,19 @@ TEST(Uncertainty, TheRegroupingFitExtrapolatesVOfBToOneBatch) {
   EXPECT_FALSE(regrouped_type_a(std::vector<double>{1.0}));
 }
 
+// One window of B = 10 batch values level + e_k - e_{k-1}, e white with SD 1: position
+// differences of a bounded error, whose mean has SD sqrt(2) / B.
+std::vector<double> difference_series(std::mt19937& rng, std::normal_distribution<double>& e, double level) {
+  std::vector<double> x(10);
+  double prev = e(rng);
+  for (auto& v : x) {
+    const double next = e(rng);
+    v = level + next - prev;
+    prev = next;
+  }
+  return x;
+}
+
 // Many windows of 10 batches: the RMS of the reported u against the true SD of the mean.
 struct Spread {
   double rms_u, rms_se, sd_u_rel;
@@ -169,18 +182,7 @@ TEST(Uncertainty, ADifferenceSeriesGivesLessThanTwiceSOverB) {
   // where s / sqrt(B) overstates by sqrt(B).
   std::mt19937 rng(11);
   std::normal_distribution<double> e(0.0, 1.0);
-  const auto s = over_windows(
-      [&] {
-        std::vector<double> x(10);
-        double prev = e(rng);
-        for (auto& v : x) {
-          const double next = e(rng);
-          v = next - prev;
-          prev = next;
-        }
-        return x;
-      },
-      20000);
+  const auto s = over_windows([&] { return difference_series(rng, e, 0.0); }, 20000);
   const double truth = std::sqrt(2.0) / 10;
   std::printf("difference: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u, s.rms_se, truth,
               s.sd_u_rel);
@@ -294,18 +296,7 @@ TEST(Uncertainty, TheEncoderSpeedsTypeAIsThePositionErrorAtTheWindowsEnds) {
   // s / sqrt(B) overstates by about sqrt(B).
   std::mt19937 rng(17);
   std::normal_distribution<double> e(0.0, 1.0);
-  const auto s = over_windows(
-      [&] {
-        std::vector<double> x(10);
-        double prev = e(rng);
-        for (auto& v : x) {
-          const double next = e(rng);
-          v = 700 + next - prev;
-          prev = next;
-        }
-        return x;
-      },
-      20000, position_bridge_type_a);
+  const auto s = over_windows([&] { return difference_series(rng, e, 700.0); }, 20000, position_bridge_type_a);
   const double truth = std::sqrt(2.0) / 10;
   std::printf("bridge: RMS u %.4f, RMS s/sqrt(B) %.4f, truth %.4f, SD(u)/RMS(u) %.3f\n", s.rms_u, s.rms_se, truth,
               s.sd_u_rel);
