@@ -238,6 +238,8 @@ void BenchRuntime::publish() {
   s.mode = mode_;
   s.synrm = supervisor_->synrm();
   s.load = supervisor_->load();
+  s.synrm_error = supervisor_->synrm_read_error();
+  s.load_error = supervisor_->load_read_error();
   s.phase = supervisor_->phase();
   s.trip = supervisor_->trip();
   s.alarm = supervisor_->alarm();

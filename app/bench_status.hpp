@@ -64,6 +64,8 @@ struct BenchStatus {
   DriveMode mode;
   std::optional<drivers::SynrmTelemetry> synrm;
   std::optional<drivers::LoadTelemetry> load;
+  // Why the last read of a drive failed, while synrm or load is empty for it (else empty).
+  std::string synrm_error, load_error;
   bench::SafetyPhase phase = bench::SafetyPhase::normal;
   std::optional<bench::SafetyTrip> trip;
   std::optional<bench::SafetyAlarm> alarm;

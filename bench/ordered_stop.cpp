@@ -11,6 +11,7 @@ void OrderedStop::begin(const drivers::BenchDevices& dev, const OrderedStopOptio
   opt_ = opt;
   step_ = StopStep::load;
   timed_out_ = false;
+  hold_speed_rpm_.reset();
   began_s_ = step_since_s_ = last_tick_s_ = now_s;
   ramp_ = LoadRamp(opt.load_ramp_Nm_per_s);
   ramp_.start(from_Nm, 0.0);
@@ -27,6 +28,13 @@ bool OrderedStop::tick(double now_s, const std::optional<drivers::SynrmTelemetry
     case StopStep::load: {
       // Commanded every tick: one write lost on a link must not leave the torque on.
       dev_.load->set_torque_Nm(ramp_.step(dt));
+      // While the load comes off, the SynRM holds the speed the shaft has, never more: a
+      // voltage-limited drive short of its setpoint (1158 of 1500 rpm) would otherwise
+      // accelerate towards it as the load goes, and overshoot the overspeed limit.
+      if (!hold_speed_rpm_ && synrm && drivers::running(synrm->state)) {
+        hold_speed_rpm_ = synrm->speed_rpm;
+        dev_.synrm->set_speed_rpm(*hold_speed_rpm_);
+      }
       const bool gone = ramp_.done() && load && std::fabs(load->torque_Nm) < opt_.load_gone_Nm;
       if (gone && opt_.coast) {
         disable_both();

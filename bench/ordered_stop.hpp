@@ -1,4 +1,5 @@
-// The ordered stop: load torque to zero, then the speed, then both drives disabled. One sequence
+// The ordered stop: load torque to zero (the SynRM holding the speed its shaft has), then the
+// speed, then both drives disabled. One sequence
 // for everyone who stops the bench: the safety supervisor after a trip, the point procedure after
 // its window or a fault, the sweep engine between configurations and at the end, the daemon's
 // runtime on a user's disable or a shutdown. Each step is
@@ -57,6 +58,7 @@ class OrderedStop {
   LoadRamp ramp_{0.0};
   double began_s_ = 0, step_since_s_ = 0, last_tick_s_ = 0, load_deadline_s_ = 0;
   bool timed_out_ = false;
+  std::optional<double> hold_speed_rpm_;  // the shaft's speed at the step's first telemetry
 };
 
 }  // namespace synbench::bench

@@ -70,6 +70,9 @@ class SafetySupervisor {
   void tick(double now_s);
   const std::optional<drivers::SynrmTelemetry>& synrm() const { return synrm_; }
   const std::optional<drivers::LoadTelemetry>& load() const { return load_; }
+  // Why this tick's read of a drive failed ("timeout (unit 1, input 0..19)"); empty when it was read.
+  const std::string& synrm_read_error() const { return synrm_read_error_; }
+  const std::string& load_read_error() const { return load_read_error_; }
 
   // Immediate disable of both drives (each request once: the caller's answer may follow at
   // once, disable_report() says what each drive made of it); latched like any trip.

@@ -12,6 +12,7 @@
 
 #include "bench/current_angle.hpp"
 #include "bench/sweep_plan.hpp"
+#include "bench/window_plausibility.hpp"
 #include "bench/sweep_presets.hpp"
 
 namespace synbench::bench {
@@ -347,7 +348,7 @@ void parse_precision(const JsonNode& v, const SweepPlan& plan, std::optional<Pre
   if (!v.has("pdcm_u_repeat_target_W") && !out)
     v["pdcm_u_repeat_target_W"].fail("required field is missing");
   set(v["pdcm_u_repeat_target_W"], p.pdcm_u_repeat_target_W, above_at_most(0, 1000, "W"));
-  set(v["max_window_s"], p.max_window_s, above_at_most(0, 3600, "s"));
+  set(v["max_window_s"], p.max_window_s, within(kMinWindow_s, 3600, "s"));
   if (auto m = v["mode"].choice<PrecisionMode>(kPrecisionModeNames, "precision mode")) p.mode = *m;
   if (p.max_window_s < plan.window_s)
     v["max_window_s"].fail("must be at least the plan's window_s (" + num(plan.window_s) + " s)");
@@ -522,7 +523,7 @@ SweepPlanParseResult parse_sweep_plan(const synbench::Json& doc) {
   parse_dimensions(root["dimensions"], plan, has_preset);
   parse_adaptive(root["adaptive"], plan.adaptive);
   parse_gate(root["gate"], plan.gate);
-  set(root["window_s"], plan.window_s, above_at_most(0, 3600, "s"));
+  set(root["window_s"], plan.window_s, within(kMinWindow_s, 3600, "s"));
   parse_precision(root["precision"], plan, plan.precision);
   parse_thermal(root["thermal"], plan.thermal, plan.limits);
   if (auto notes = root["notes"].texts()) plan.notes = *notes;

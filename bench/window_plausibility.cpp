@@ -51,6 +51,11 @@ std::optional<std::string> implausible_window(const drivers::SynrmWindow& w, con
     if (e.value && !std::isfinite(*e.value)) return say(e.field, drivers::printf_text("%g is not a finite number", *e.value));
 
   if (w.samples == 0) return std::string("window_samples: 0, a window without samples");
+  // Too few samples to be a mean: a window of one control period reads the instant's speed
+  // (0 rpm at a 300 rpm setpoint) and its efficiency as a measurement (docs/record.md).
+  if (const std::uint32_t least = min_window_samples(w.keeper); w.samples < least)
+    return "window_samples: " + std::to_string(w.samples) + ", fewer than the " + std::to_string(least) + " a " +
+           (w.keeper == drivers::WindowKeeper::host ? "host-kept window's polls" : "drive's window") + " must hold to be a mean";
   if (!(w.window_s > 0)) return say("window_s", drivers::printf_text("%g s: a window has a length", w.window_s));
   if (w.im_A < -kMagnitudeTolerance_A)
     return say("window_im_A", drivers::printf_text("%g A is negative: it is the mean of a current magnitude", w.im_A));

@@ -5,6 +5,7 @@
 // stored: a wrong efficiency in the database is worse than a missing one. Pure logic.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -12,6 +13,14 @@
 #include "drivers/devices.hpp"
 
 namespace synbench::bench {
+
+// The shortest window a plan or a point may ask for: 10 VFC sub-gates of 10 ms (100 PWM periods
+// each at 10 kHz, 1000 counts at the converters' 100 kHz/A span per 1 A), 100 speed-loop periods.
+// Shorter, one count or one period is a sizeable part of the mean (docs/sweep-plan.md).
+constexpr double kMinWindow_s = 0.1;
+// The fewest samples a window may hold and still be stored: the drive's control periods (a
+// drive accumulating at 1 kHz holds 100 in kMinWindow_s), or the bench's polls of a host-kept one.
+constexpr std::uint32_t min_window_samples(drivers::WindowKeeper k) { return k == drivers::WindowKeeper::host ? 5 : 100; }
 
 // The first implausible field as "window_im_A: -99 A is negative (a current magnitude)", or
 // nothing. Field names are the register map's (docs/register-map.md).

@@ -5,5 +5,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-scripts/build.sh release
+scripts/build.sh release synbench  # the daemon alone; the tests are test.sh's
 exec build/release/server/synbench serve --listen 127.0.0.1:8080 "$@"  # data: ./synbench-data

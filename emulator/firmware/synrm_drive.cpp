@@ -257,7 +257,14 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       const double dt = ts_ * speed_divider_;
       const double max_step = cfg_.firmware.speed_ramp_rpm_per_s * dt;
       speed_ref_rpm_ += std::clamp(speed_set_rpm_ - speed_ref_rpm_, -max_step, max_step);
-      im_req_A_ = speed_pi_.update((speed_ref_rpm_ - speed_ctrl_rpm) / kRpmPerRadS, dt);
+      // Conditional integration while the voltage limit holds: the current loops cannot give
+      // more current, so integrating the speed error further only winds the reference up to the
+      // current limit; when the load then comes off (the ordered stop), that stored torque
+      // drove a 1158 rpm shaft past 1650 rpm, the overspeed trip. An error that would take the
+      // reference back out of the limit still integrates.
+      const double speed_error = (speed_ref_rpm_ - speed_ctrl_rpm) / kRpmPerRadS;
+      const bool winding_up = limited_hold_s_ > 0 && speed_error * im_req_A_ > 0;
+      im_req_A_ = speed_pi_.update(speed_error, dt, winding_up);
     }
     // Sensorless, the current angle moves at a limited rate [assumed]: a step of the current
     // vector's direction at full current (76 to 40 deg between chained sweep points) is the

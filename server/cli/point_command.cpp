@@ -10,6 +10,7 @@
 #include "bench/current_angle.hpp"
 #include "bench/point_procedure.hpp"
 #include "bench/safety_supervisor.hpp"
+#include "bench/window_plausibility.hpp"
 #include "drivers/bench_config.hpp"
 #include "drivers/profile/number_format.hpp"
 #include "emulator/firmware/estimators/factory.hpp"
@@ -118,8 +119,9 @@ int point_command(const std::vector<std::string>& argv) {
                                         "] N m (the load drive's current limit)");
     if (!bench::is_motoring_angle(req.angle_deg))
       throw UsageError("--angle-deg", drivers::format_number(req.angle_deg) + " is outside (0, 90) deg");
-    if (req.window_s <= 0 || req.window_s > 3600)
-      throw UsageError("--window-s", drivers::format_number(req.window_s) + " is outside (0, 3600] s");
+    if (!(req.window_s >= bench::kMinWindow_s && req.window_s <= 3600))
+      throw UsageError("--window-s", drivers::format_number(req.window_s) + " is outside [" +
+                                         drivers::format_number(bench::kMinWindow_s) + ", 3600] s");
     if (auto avail = emulator::firmware::make_estimator(req.estimator, config); avail.error)
       throw UsageError("--estimator", "'" + std::string(drivers::name(req.estimator)) +
                                           "' is not available in the twin yet");

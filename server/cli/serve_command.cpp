@@ -122,6 +122,24 @@ int serve_command(const std::vector<std::string>& argv) {
     return 1;
   }
   ::chmod(data_dir.c_str(), 0700);  // the tokens' digests and the database are the operator's own
+  // Everything this daemon creates is the operator's alone too: the database and its -wal and
+  // -shm (SQLite creates them 0644 by default), the telemetry history. Files an earlier version
+  // created are tightened as well.
+  ::umask(077);
+  for (const char* name : {"synbench.db", "synbench.db-wal", "synbench.db-shm", "telemetry-history.bin"})
+    if (std::filesystem::exists(data_dir / name, ec)) ::chmod((data_dir / name).c_str(), 0600);
+  // A data directory that held a store (its -wal or -shm, the telemetry history, tokens) but no
+  // longer holds the database: a new empty store would be created without a word. Said loudly.
+  if (options.db.empty() && !std::filesystem::exists(data_dir / "synbench.db", ec)) {
+    std::string traces;
+    for (const char* name : {"synbench.db-wal", "synbench.db-shm", "telemetry-history.bin", "tokens.json"})
+      if (std::filesystem::exists(data_dir / name, ec)) traces += std::string(traces.empty() ? "" : ", ") + name;
+    if (!traces.empty())
+      std::cerr << "synbench serve: WARNING: " << (data_dir / "synbench.db").string()
+                << " is missing, but the data directory holds an earlier store's files (" << traces
+                << "): the sweeps stored there are not in the new, empty database created now. If it was moved or "
+                   "deleted by mistake, stop the daemon and put it back before running anything\n";
+  }
 
   http::TokenStore tokens(data_dir / "tokens.json");
   if (auto e = tokens.load()) {

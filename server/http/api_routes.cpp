@@ -4,6 +4,7 @@
 #include "server/http/info_routes.hpp"
 #include "server/http/instance_id.hpp"
 
+#include "server/http/metrics_text.hpp"
 #include "server/http/response_schemas.hpp"
 
 #include "bench/current_angle.hpp"
@@ -130,6 +131,10 @@ synbench::Json status_json(const BenchStatus& s) {
   } else {
     j["load"] = nullptr;
   }
+  // A drive that could not be read is null, and the read's error says why (never silently null).
+  const auto read_error = [](const std::string& e) { return e.empty() ? synbench::Json(nullptr) : synbench::Json(e); };
+  j["synrm_error"] = read_error(s.synrm_error);
+  j["load_error"] = read_error(s.load_error);
   j["supervisor"] = {{"phase", phase_name(s.phase)}, {"tripped", s.trip.has_value()}};
   if (s.trip)
     j["supervisor"]["trip"] = {{"fault", std::string(drivers::fault_name(s.trip->fault))},
@@ -155,45 +160,6 @@ synbench::Json status_json(const BenchStatus& s) {
   for (const auto& e : s.events) ev.push_back({{"t_s", e.t_s}, {"kind", e.kind}, {"message", e.message}});
   j["events"] = ev;
   return j;
-}
-
-std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
-                            const std::optional<WsCounts>& ws, const std::optional<ConnectionCounts>& connections) {
-  std::ostringstream o;
-  auto gauge = [&](const char* name, const char* help, double v) {
-    o << "# HELP " << name << " " << help << "\n# TYPE " << name << " gauge\n" << name << " " << v << "\n";
-  };
-  gauge("synbench_bench_time_seconds", "Bench (twin) time since the daemon started.", s.t_s);
-  gauge("synbench_bench_enabled", "1 while the drives are enabled by an operator.", s.enabled ? 1 : 0);
-  gauge("synbench_supervisor_tripped", "1 while the safety supervisor's trip is latched.", s.trip ? 1 : 0);
-  gauge("synbench_supervisor_alarm", "1 while a drive has not read back stopped after its disable.", s.alarm ? 1 : 0);
-  gauge("synbench_heartbeats", "1 while the drives' watchdog heartbeats are sent (0 after an E-stop).", s.heartbeats ? 1 : 0);
-  if (s.synrm) {
-    gauge("synbench_synrm_speed_rpm", "SynRM speed.", s.synrm->speed_rpm);
-    gauge("synbench_synrm_current_A", "SynRM current magnitude.", s.synrm->im_A);
-    gauge("synbench_synrm_udc_V", "DC-bus voltage at the SynRM drive.", s.synrm->udc_V);
-    // No gauge without a sensor: a scraped 0 would read as a cold winding.
-    if (s.synrm->temp_C) gauge("synbench_synrm_temp_C", "SynRM winding temperature.", *s.synrm->temp_C);
-    gauge("synbench_synrm_pac_W", "SynRM drive output power estimate.", s.synrm->pac_W);
-  }
-  if (s.load) gauge("synbench_load_torque_Nm", "Braking torque of the load machine.", s.load->torque_Nm);
-  o << "# HELP synbench_loop_ticks_total Bench loop ticks.\n# TYPE synbench_loop_ticks_total counter\n"
-    << "synbench_loop_ticks_total " << s.ticks << "\n";
-  o << "# HELP synbench_loop_overruns_total Bench loop ticks that started late.\n# TYPE synbench_loop_overruns_total counter\n"
-    << "synbench_loop_overruns_total " << s.overruns << "\n";
-  o << "# HELP synbench_http_requests_total HTTP requests answered, by status.\n# TYPE synbench_http_requests_total counter\n";
-  for (const auto& [code, n] : http_by_status) o << "synbench_http_requests_total{status=\"" << code << "\"} " << n << "\n";
-  if (connections) {
-    gauge("synbench_http_connections", "HTTP and WebSocket connections open.", static_cast<double>(connections->open));
-    o << "# HELP synbench_http_connections_evicted_total Connections closed to make room for a new one (the least trusted, oldest).\n"
-      << "# TYPE synbench_http_connections_evicted_total counter\nsynbench_http_connections_evicted_total " << connections->evicted << "\n";
-  }
-  if (ws) {
-    gauge("synbench_ws_clients", "WebSocket clients connected.", static_cast<double>(ws->clients));
-    o << "# HELP synbench_ws_dropped_total WebSocket clients dropped for not reading (queue bound or write stall).\n"
-      << "# TYPE synbench_ws_dropped_total counter\nsynbench_ws_dropped_total " << ws->dropped << "\n";
-  }
-  return o.str();
 }
 
 void add_api_routes(Router& router, ApiContext ctx) {

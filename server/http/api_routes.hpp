@@ -136,8 +136,5 @@ BenchRuntime::Done answer(Reply reply, int ok_status = 200);
 Response status_response(const app::StatusSnapshot& s);
 // The supervisor's phase as the API names it: "normal", "stopping_load", ... "estopped".
 const char* phase_name(bench::SafetyPhase p);
-std::string prometheus_text(const BenchStatus& s, const std::map<int, std::uint64_t>& http_by_status,
-                            const std::optional<WsCounts>& ws = std::nullopt,
-                            const std::optional<ConnectionCounts>& connections = std::nullopt);
 
 }  // namespace synbench::http

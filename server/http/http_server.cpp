@@ -4,6 +4,9 @@
 #include <array>
 #include <chrono>
 #include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
@@ -81,6 +84,45 @@ Trust trust_of(const std::optional<Identity>& who) {
   return who->role == Role::operator_ ? Trust::operator_ : who->role == Role::viewer ? Trust::viewer : Trust::none;
 }
 
+// A request whose framing or identity is ambiguous: answered (400, or 501 for a transfer coding
+// we do not implement) and the connection closed, since its body can not be told from the next
+// request. RFC 9112 Sec. 6.1 and 6.3: a transfer coding other than a final "chunked", or one on
+// an HTTP/1.0 request; Sec. 3.2: more than one Host. More than one Authorization is refused too:
+// which of them the daemon acted on must never be a guess.
+struct FramingProblem {
+  int status;
+  std::string message;
+};
+
+std::optional<FramingProblem> framing_problem(const bhttp::request_header<>& h) {
+  if (h.count(bhttp::field::host) > 1) return FramingProblem{400, "more than one Host header"};
+  if (h.count(bhttp::field::authorization) > 1) return FramingProblem{400, "more than one Authorization header"};
+  if (!h.count(bhttp::field::transfer_encoding)) return std::nullopt;
+  if (h.version() < 11) return FramingProblem{400, "Transfer-Encoding in an HTTP/1.0 request (RFC 9112 Sec. 6.1)"};
+  if (h.count(bhttp::field::content_length))
+    return FramingProblem{400, "both Transfer-Encoding and Content-Length (RFC 9112 Sec. 6.1)"};
+  std::vector<std::string> codings;
+  const auto [first, last] = h.equal_range(bhttp::field::transfer_encoding);
+  for (auto f = first; f != last; ++f) {
+    const std::string v(f->value());
+    std::size_t start = 0;
+    while (start <= v.size()) {
+      std::size_t end = v.find(',', start);
+      if (end == std::string::npos) end = v.size();
+      std::string c = v.substr(start, end - start);
+      c = c.substr(0, c.find(';'));
+      const auto b = c.find_first_not_of(" \t"), e = c.find_last_not_of(" \t");
+      if (b != std::string::npos) codings.push_back(ascii_lower(c.substr(b, e - b + 1)));
+      start = end + 1;
+    }
+  }
+  if (codings.empty() || codings.back() != "chunked")
+    return FramingProblem{400, "Transfer-Encoding must end in chunked (RFC 9112 Sec. 6.3)"};
+  if (codings.size() > 1)
+    return FramingProblem{501, "transfer coding '" + codings.front() + "' is not implemented (only chunked is)"};
+  return std::nullopt;
+}
+
 class Session : public std::enable_shared_from_this<Session> {
  public:
   Session(tcp::socket&& socket, std::shared_ptr<HttpServer::Shared> shared)
@@ -121,6 +163,17 @@ class Session : public std::enable_shared_from_this<Session> {
     // A peer that has never shown a token gets little time: trickling bytes buys it nothing.
     const double timeout_s = trust_ == Trust::none ? shared_->limits.unauthenticated_timeout_s : shared_->limits.read_timeout_s;
     stream_.expires_after(std::chrono::milliseconds(static_cast<long>(timeout_s * 1000)));
+    // The header section first: its framing is checked before a byte of the body is read, and
+    // it is kept, so that chunked trailer fields never act as headers.
+    bhttp::async_read_header(stream_, buffer_, *parser_, beast::bind_front_handler(&Session::on_header, shared_from_this()));
+  }
+
+  void on_header(beast::error_code ec, std::size_t n) {
+    if (ec) return on_read(ec, n);
+    if (const auto bad = framing_problem(parser_->get()))
+      return send_error(bad->status, bad->status == 501 ? "not_implemented" : "bad_request", bad->message, false);
+    header_ = parser_->get().base();
+    if (parser_->is_done()) return on_read({}, 0);
     bhttp::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&Session::on_read, shared_from_this()));
   }
 
@@ -141,7 +194,9 @@ class Session : public std::enable_shared_from_this<Session> {
     // Nothing thrown while answering may reach io.run(): it would end the daemon for every
     // client. The request is answered 500 and the line on stderr says what was caught.
     try {
-      handle(parser_->release());
+      auto req = parser_->release();
+      req.base() = std::move(header_);  // the header section only: trailer fields are dropped
+      handle(std::move(req));
     } catch (const std::exception& e) {
       std::cerr << "synbench serve: internal error answering a request: " << drivers::escape_invalid_utf8(e.what()) << "\n";
       send_error(500, "internal", "the request failed inside the daemon", false);
@@ -165,10 +220,7 @@ class Session : public std::enable_shared_from_this<Session> {
     const std::string target(req.target());
     const std::string path = target.substr(0, target.find('?'));
     Response r;
-    if (req.count(bhttp::field::host) > 1) {
-      // Two Host headers name two targets; RFC 9112 Sec. 3.2 asks for a 400.
-      r = error_response(400, "bad_request", "more than one Host header");
-    } else if (!shared_->hosts.count(ascii_lower(host))) {
+    if (!shared_->hosts.count(ascii_lower(host))) {
       r = error_response(403, "host_not_allowed", "the Host header must name the listen address");
     } else if (path == "/ws" && shared_->hub) {
       const std::string origin(req[bhttp::field::origin]);
@@ -272,6 +324,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
+  bhttp::request_header<> header_;  // the request's header section, as read before its body
   std::shared_ptr<HttpServer::Shared> shared_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
   std::shared_ptr<ConnectionSlot> slot_;  // empty for a connection refused at the door

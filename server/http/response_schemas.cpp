@@ -67,6 +67,8 @@ synbench::Json status_schema() {
        {"load", closed_object({{"torque_Nm", kNum}, {"iq_A", kNum}, {"state", kStr}, {"fault", kStr},
                                {"fault_code_raw", code_raw}},
                               true)},
+       {"synrm_error", nullable(kStr)},
+       {"load_error", nullable(kStr)},
        {"supervisor",
         closed_object({{"phase", {{"type", "string"},
                                   {"enum", {"normal", "stopping_load", "stopping_speed", "stopped", "estopped"}}}},

@@ -15,6 +15,7 @@
 #include "bench/sweep_plan.hpp"
 #include "bench/sweep_plan_bench_limits.hpp"
 #include "bench/sweep_presets.hpp"
+#include "bench/window_plausibility.hpp"
 #include "db/export.hpp"
 #include "server/http/api_routes.hpp"
 #include "server/http/response_schemas.hpp"
@@ -178,7 +179,7 @@ synbench::Json plan_schema() {
             {"mode", {{"type", "string"}, {"enum", synbench::Json::array({"grid", "adaptive"})}}},
             {"adaptive", object},
             {"gate", object},
-            {"window_s", {{"type", "number"}, {"minimum", 0}, {"exclusiveMinimum", true}, {"maximum", 3600}}},
+            {"window_s", {{"type", "number"}, {"minimum", bench::kMinWindow_s}, {"maximum", 3600}}},
             {"precision", {{"type", "object"}, {"nullable", true},
                            {"description", "measure until sure: pdcm_u_repeat_target_W, max_window_s, mode"}}},
             {"thermal", object},

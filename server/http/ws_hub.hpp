@@ -33,6 +33,10 @@ struct WsLimits {
   // near max_queue_bytes would drop the client that asked for it.
   std::size_t max_reply_bytes = 512 * 1024;
   std::chrono::milliseconds write_stall{5000};     // one write in flight longer: dropped
+  // Requests of one session whose reply is not yet written: at this many the session reads no
+  // further message until one is, so a burst costs the io thread this many replies, not one per
+  // message sent (a client that never reads is then dropped by write_stall).
+  std::size_t max_requests_in_flight = 8;
   std::chrono::milliseconds auth_timeout{5000};    // for the first message, {"op":"auth"}
   // The kernel's send buffer of a session's socket. Bounded so a reader that stalls fills it in
   // seconds and the stall is seen; autotuned it could absorb minutes of telemetry.

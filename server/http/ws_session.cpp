@@ -120,7 +120,17 @@ void WsSession::on_read(beast::error_code ec, std::size_t) {
       }
     }
   }
-  if (!dropped_) do_read();
+  if (dropped_) return;
+  if (requests_in_flight_ >= hub_->limits().max_requests_in_flight) read_paused_ = true;
+  else do_read();
+}
+
+void WsSession::reply_done() {
+  if (requests_in_flight_ > 0) --requests_in_flight_;
+  if (read_paused_ && !dropped_ && requests_in_flight_ < hub_->limits().max_requests_in_flight) {
+    read_paused_ = false;
+    do_read();
+  }
 }
 
 void WsSession::handle(const std::string& text) {
@@ -213,6 +223,7 @@ void WsSession::handle_request(const synbench::Json& doc) {
   const synbench::Json id = doc.contains("id") ? doc["id"] : synbench::Json(nullptr);
   std::string body;
   if (doc.contains("body")) body = dump_json(doc["body"]);
+  ++requests_in_flight_;
   // Through the REST router with this session's token: the same roles, lock and validation. A
   // bench command answers from the bench thread: the reply comes back to this session's strand.
   hub_->router().dispatch_async(doc["method"].get<std::string>(), doc["path"].get<std::string>(), "Bearer " + token_,
@@ -230,7 +241,8 @@ void WsSession::reply(const synbench::Json& id, const Response& r) {
                         {"body", {{"error", {{"code", "reply_too_large"},
                                              {"message", "the reply is " + std::to_string(bytes) + " bytes, over the WebSocket's " +
                                                              std::to_string(max) + "-byte limit: ask for less (the points route "
-                                                             "pages with ?offset=&limit=) or use REST"}}}}}});
+                                                             "pages with ?offset=&limit=) or use REST"}}}}}},
+         true);
   };
   if (r.body.size() > max) return too_large(r.body.size());
   try {
@@ -248,11 +260,12 @@ void WsSession::reply(const synbench::Json& id, const Response& r) {
     }
     auto text = std::make_shared<const std::string>(dump_json(message));
     if (text->size() > max) return too_large(text->size());
-    send(std::move(text));
+    send(std::move(text), true);
   } catch (const std::exception& e) {
     std::cerr << "synbench serve: websocket reply failed: " << drivers::escape_invalid_utf8(e.what()) << "\n";
     send(synbench::Json{{"type", "reply"}, {"id", id}, {"status", 500},
-                        {"body", {{"error", {{"code", "internal"}, {"message", "the reply could not be built"}}}}}});
+                        {"body", {{"error", {{"code", "internal"}, {"message", "the reply could not be built"}}}}}},
+         true);
   }
 }
 
@@ -298,32 +311,43 @@ void WsSession::on_tick(const HubTick& tick) {
     for (const auto& e : tick.events) send(e);
 }
 
-void WsSession::send(const synbench::Json& message) { send(std::make_shared<const std::string>(dump_json(message))); }
+void WsSession::send(const synbench::Json& message, bool reply) {
+  send(std::make_shared<const std::string>(dump_json(message)), reply);
+}
 
-void WsSession::send(SharedText message) {
-  if (dropped_ || closing_) return;
+void WsSession::send(SharedText message, bool reply) {
+  if (dropped_ || closing_) {
+    if (reply) reply_done();
+    return;
+  }
   const WsLimits& lim = hub_->limits();
   if (queue_.size() + 1 > lim.max_queue_messages || queued_bytes_ + message->size() > lim.max_queue_bytes)
     return drop("its send queue is full (" + std::to_string(queue_.size()) + " messages, " + std::to_string(queued_bytes_) +
                 " bytes): it does not read");
   queued_bytes_ += message->size();
-  queue_.push_back(std::move(message));
+  queue_.push_back({std::move(message), reply});
   if (!writing_) do_write();
 }
 
 void WsSession::do_write() {
   writing_ = true;
   write_started_ = std::chrono::steady_clock::now();
-  ws_.async_write(net::buffer(*queue_.front()), beast::bind_front_handler(&WsSession::on_write, shared_from_this()));
+  ws_.async_write(net::buffer(*queue_.front().text), beast::bind_front_handler(&WsSession::on_write, shared_from_this()));
 }
 
 void WsSession::on_write(beast::error_code ec, std::size_t) {
   writing_ = false;
   if (dropped_) return;
   if (ec) return fail(ec, "write");
-  queued_bytes_ -= queue_.front()->size();
+  queued_bytes_ -= queue_.front().text->size();
+  const bool was_reply = queue_.front().reply;
   queue_.pop_front();
-  if (!queue_.empty()) return do_write();
+  if (was_reply) reply_done();
+  if (dropped_) return;
+  if (!queue_.empty()) {
+    if (!writing_) do_write();
+    return;
+  }
   close_if_due();
 }
 

@@ -3,6 +3,7 @@
 // 5 s, else an `unauthorized` error and close 1008; then subscribe/unsubscribe to telemetry
 // (at the client's rate), sweep and events, and `request`s dispatched through the REST Router
 // with the session's token, so roles, the control lock and validation are REST's own.
+// Requests: at most WsLimits::max_requests_in_flight unanswered before the session reads on.
 // Writes: one in flight, behind a bounded queue; a client whose queue overflows or whose write
 // stalls is dropped (its socket closed) so it costs the daemon neither memory nor other
 // clients' rate.
@@ -52,8 +53,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void bad_message(const std::string& message);
   // An `unauthorized` error, then close 1008 once it is written.
   void refuse(const std::string& message);
-  void send(SharedText message);
-  void send(const synbench::Json& message);
+  // `reply`: the message answers a request (it counts in requests_in_flight_ until written).
+  void send(SharedText message, bool reply = false);
+  void send(const synbench::Json& message, bool reply = false);
+  // A request's reply was written (or will never be): reading resumes if it waited for this.
+  void reply_done();
   void do_write();
   void on_write(boost::beast::error_code ec, std::size_t bytes);
   // The planned close (after refuse()) once the queue is written.
@@ -82,7 +86,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::optional<double> next_tick_;   // hub tick index of the next telemetry message
 
   // The write queue: at most one async_write in flight.
-  std::deque<SharedText> queue_;
+  struct Queued {
+    SharedText text;
+    bool reply;
+  };
+  std::deque<Queued> queue_;
+  std::size_t requests_in_flight_ = 0;  // dispatched requests whose reply is not yet written
+  bool read_paused_ = false;            // no read pending: waiting for requests_in_flight_ to fall
   std::size_t queued_bytes_ = 0;
   bool writing_ = false;
   std::chrono::steady_clock::time_point write_started_{};

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -123,6 +124,89 @@ TEST(OrderedStop, UnansweredStepsEndOnTheirTimeouts) {
   EXPECT_NEAR(done_at - speed_step_at, 2.0, 0.02);
   EXPECT_TRUE(stop.timed_out());
   EXPECT_TRUE(r.drives_off());
+}
+
+// A voltage-limited point (issue 37): at 1500 rpm asked with 3.5 N m at 60 deg the 420 V bus holds
+// the shaft near 1160 rpm. The stop takes the load off first; neither the speed loop's integrator
+// (wound up to the current limit while the voltage limit held, before the fix) nor the 1500 rpm
+// setpoint may then accelerate the shaft: it rises no more than the speed loop's answer to the
+// load ramp on a point that is not limited (about 70 rpm at 2 N m/s), far below the 1650 rpm
+// overspeed trip (1.1 x the maximum speed) that the old code reached (1651 rpm).
+struct StopRun {
+  bool voltage_limited = false;
+  double set_rpm = 0, shaft_rpm = 0, peak_rpm = 0, end_rpm = 0;
+  bool done = false, timed_out = false;
+};
+
+StopRun stop_from(double speed_rpm, double load_Nm, double angle_deg, double udc_V) {
+  emulator::TwinConfig config;
+  config.scale_bus_to(udc_V);
+  emulator::TwinBench bench{config};
+  auto d = bench.devices();
+  StopRun r;
+  r.set_rpm = speed_rpm;
+  double t = 0;
+  const auto advance = [&](double s) {
+    for (const double end = t + s; t < end - 1e-9;) {
+      t += 0.01;
+      bench.clock().wait_until(t);
+      r.peak_rpm = std::max(r.peak_rpm, std::fabs(bench.twin().snapshot().speed_rpm));
+    }
+  };
+  if (d.load->enable(true) || d.synrm->set_angle_deg(angle_deg) || d.synrm->set_speed_rpm(speed_rpm) || d.synrm->enable(true))
+    return r;
+  advance(2.0);
+  for (double l = 0.5; l <= load_Nm + 1e-9; l += 0.5) {  // the load at 2.5 N m/s
+    if (d.load->set_torque_Nm(l)) return r;
+    advance(0.2);
+  }
+  advance(4.0);  // the voltage limit holds: long enough to wind an integrator up fully
+  drivers::SynrmTelemetry before;
+  if (d.synrm->read(before)) return r;
+  r.voltage_limited = before.voltage_limited;
+  r.shaft_rpm = bench.twin().snapshot().speed_rpm;
+  OrderedStop stop;
+  OrderedStopOptions opt;
+  opt.load_ramp_Nm_per_s = kBenchLoadRamp_Nm_per_s;
+  stop.begin(d, opt, t, load_Nm);
+  r.peak_rpm = 0;
+  for (const double end = t + 30; t < end && !r.done;) {
+    advance(0.01);
+    drivers::SynrmTelemetry s;
+    drivers::LoadTelemetry l;
+    const bool sr = !d.synrm->read(s), lr = !d.load->read(l);
+    r.done = stop.tick(t, sr ? std::optional(s) : std::nullopt, lr ? std::optional(l) : std::nullopt);
+  }
+  r.timed_out = stop.timed_out();
+  r.end_rpm = bench.twin().snapshot().speed_rpm;
+  return r;
+}
+
+TEST(OrderedStop, AVoltageLimitedPointStopsWithoutOvershoot) {
+  // The speed loop's own answer to the load ramp, on a point with voltage to spare.
+  const StopRun free = stop_from(800, 3.5, 60, 420);
+  ASSERT_TRUE(free.done);
+  ASSERT_FALSE(free.voltage_limited);
+  const double free_rise_rpm = free.peak_rpm - free.shaft_rpm;
+  EXPECT_GT(free_rise_rpm, 20.0) << "the loop answers the load ramp";
+  EXPECT_LT(free_rise_rpm, 120.0);
+  struct Case {
+    double speed_rpm, load_Nm, angle_deg, udc_V;
+  };
+  for (const Case c : {Case{1500, 3.5, 60, 420}, Case{1500, 3.0, 60, 420}, Case{1400, 3.5, 60, 400},
+                       Case{1300, 3.5, 50, 420}, Case{1500, 3.5, 50, 400}}) {
+    SCOPED_TRACE(testing::Message() << c.speed_rpm << " rpm, " << c.load_Nm << " N m, " << c.angle_deg << " deg, "
+                                    << c.udc_V << " V");
+    const StopRun r = stop_from(c.speed_rpm, c.load_Nm, c.angle_deg, c.udc_V);
+    ASSERT_TRUE(r.voltage_limited) << "the case must be a voltage-limited point";
+    ASSERT_LT(r.shaft_rpm, c.speed_rpm - 50) << "short of its setpoint";
+    ASSERT_TRUE(r.done);
+    EXPECT_FALSE(r.timed_out);
+    EXPECT_LT(r.peak_rpm - r.shaft_rpm, 1.5 * free_rise_rpm)
+        << "from " << r.shaft_rpm << " to " << r.peak_rpm << " rpm; unlimited, the loop rises " << free_rise_rpm << " rpm";
+    EXPECT_LT(r.peak_rpm, 1650.0);
+    EXPECT_LT(std::fabs(r.end_rpm), 50.0);
+  }
 }
 
 }  // namespace

@@ -264,6 +264,11 @@ INSTANTIATE_TEST_SUITE_P(
                   {"/adaptive/bracket_deg/0"}},
         ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50]}, "window_s": 0})",
                   {"/window_s"}},
+        // A window of one control period would be stored as a point (0 rpm at 100 rpm asked).
+        ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50]}, "window_s": 1e-300})",
+                  {"/window_s"}},
+        ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50]}, "window_s": 0.099})",
+                  {"/window_s"}},
         ErrorCase{R"({"dimensions": {"speed_rpm": [100], "load_Nm": [1], "angle_deg": [50]},
                       "gate": {"span_s": -1, "im_band_min_A": 0, "timeout_s": 0.2}})",
                   {"/gate/span_s", "/gate/im_band_min_A", "/gate/timeout_s"}},

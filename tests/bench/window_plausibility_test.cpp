@@ -47,6 +47,16 @@ TEST(WindowPlausibility, AMeasuredWindowPasses) {
   EXPECT_FALSE(at_rest.check());
 }
 
+TEST(WindowPlausibility, TheFewestSamplesPass) {
+  Window device;
+  device.w.samples = 100;
+  EXPECT_FALSE(device.check());
+  Window host;
+  host.w.keeper = drivers::WindowKeeper::host;
+  host.w.samples = 5;
+  EXPECT_FALSE(host.check());
+}
+
 TEST(WindowPlausibility, ImpossibleValuesAreNamed) {
   struct Case {
     const char* field;
@@ -60,6 +70,12 @@ TEST(WindowPlausibility, ImpossibleValuesAreNamed) {
       {"window_udc_V", [](Window& x) { x.w.udc_V = -20; }},
       {"window_temp_C", [](Window& x) { x.w.temp_C = -50; }},
       {"window_samples", [](Window& x) { x.w.samples = 0; }},
+      {"window_samples", [](Window& x) { x.w.samples = 1; }},   // the 1e-300 s window of one period
+      {"window_samples", [](Window& x) { x.w.samples = 99; }},  // under the 100 a drive's window holds at 1 kHz
+      {"window_samples", [](Window& x) {
+         x.w.keeper = drivers::WindowKeeper::host;
+         x.w.samples = 4;
+       }},
       {"window_s", [](Window& x) { x.w.window_s = 0; }},
       {"window_voltage_limited_fraction", [](Window& x) { x.w.voltage_limited_fraction = 1.5; }},
       {"window_ld_est_H", [](Window& x) { x.w.ld_est_H = std::nan(""); }},

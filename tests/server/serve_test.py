@@ -10,6 +10,7 @@ import http.client
 import json
 import os
 import re
+import shutil
 import socket
 import stat
 import subprocess
@@ -330,7 +331,17 @@ def main():
         check(s == 409 and error_of(data)[0] == "bench_enabled", "mode change refused while enabled")
         check(st["synrm"]["pos_err_deg"] is None, "no live position error with the encoder")
         s, data, _ = d.http("GET", "/metrics")
-        check(s == 200 and "synbench_synrm_speed_rpm" in data.decode(), "metrics has the speed")
+        m = re.search(r"^synbench_synrm_speed_revolutions_per_minute (\S+)$", data.decode(), re.M)
+        check(s == 200 and m and abs(float(m.group(1)) - 400) < 20, "metrics has the speed (%s)" % (m and m.group(1)))
+        # Prometheus's own linter on the exposition (Debian's prometheus package).
+        promtool = shutil.which("promtool")
+        if promtool:
+            lint = subprocess.run([promtool, "check", "metrics"], input=data, capture_output=True)
+            check(lint.returncode == 0 and not lint.stdout.strip() and not lint.stderr.strip(),
+                  "promtool check metrics passes, no warning (%r %r)" % (lint.stdout[-300:], lint.stderr[-300:]))
+        else:
+            check(not os.environ.get("CI"), "promtool is installed (scripts/install-deps.sh installs prometheus)")
+            print("SKIP: promtool check metrics (no promtool)")
         check("synbench_ws_clients 0" in data.decode() and "synbench_ws_dropped_total 0" in data.decode(),
               "metrics counts WebSocket clients and drops")
 

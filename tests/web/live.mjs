@@ -141,9 +141,9 @@ try {
   const buffered = await page.evaluate(() => window.synbench.live.buf.length);
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#scope-csv')]);
   const csv = fs.readFileSync(await download.path(), 'utf8').trim().split('\n');
-  const header = 't_s,speed_rpm,cmd_speed_rpm,torque_Nm,cmd_load_Nm,theta_i_deg,cmd_angle_deg,im_A,id_A,iq_A,udc_V,pdc_W,temp_C,pos_err_deg';
+  const header = 't_s,speed_rpm,cmd_speed_rpm,torque_Nm,cmd_load_Nm,theta_i_deg,cmd_angle_deg,im_A,id_A,iq_A,udc_V,pac_W,pdcm_W,temp_C,pos_err_deg';
   check(csv[0] === header, `the CSV's header has the units: ${csv[0]}`);
-  check(csv.length - 1 >= buffered && buffered > 200 && csv.slice(1).every((l) => l.split(',').length === 14 && Number.isFinite(Number(l.split(',')[0]))),
+  check(csv.length - 1 >= buffered && buffered > 200 && csv.slice(1).every((l) => l.split(',').length === 15 && Number.isFinite(Number(l.split(',')[0]))),
     `the CSV has one row per sample (${csv.length - 1} rows, ${buffered} buffered)`);
 
   // A hidden channel: not drawn, still hidden after a reload.

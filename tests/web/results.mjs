@@ -197,7 +197,7 @@ try {
   check(reached, 'Tab reaches the efficiency map chart');
   await page.keyboard.press('ArrowRight');
   const s500 = em.speeds_rpm.indexOf(500);
-  const wantMap = `load torque T_L [N m] ${em.loads_Nm[0]}, speed [rpm] ${em.speeds_rpm[0]}: ${Number((em.efficiency[0][0] * 100).toFixed(1))}`;
+  const wantMap = `speed [rpm] ${em.speeds_rpm[0]}, load torque T_L [N m] ${em.loads_Nm[0]}: ${Number((em.efficiency[0][0] * 100).toFixed(1))}`;
   const mapRead = await text(page, '[data-chart="r-map"] .point-readout');
   check(s500 === 0 && mapRead.includes(wantMap), `the map's first cell is read out: ${mapRead}`);
   for (let i = 0; i < 10 && !(await page.evaluate(() => document.activeElement?.closest('[data-chart="r-traj"]') && document.activeElement.classList.contains('chart'))); i++)

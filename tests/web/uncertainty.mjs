@@ -164,7 +164,7 @@ try {
   check(mapTip.includes(`± ${fu(u00)} % (k=1)`), `the map's cell tooltip gives η ± u: "${mapTip.slice(0, 120)}" (u ${fu(u00)} %)`);
   await page.click('#r-map-u');
   const uMap = await page.evaluate(() => window.synbench.resultsView.cards.map.option.series[0].data.map((d) => d.value));
-  const wantU = em.speeds_rpm.flatMap((s, i) => em.loads_Nm.map((l, j) => [j, i, Number((em.efficiency_u[i][j] * 100).toFixed(4))]));
+  const wantU = em.speeds_rpm.flatMap((s, i) => em.loads_Nm.map((l, j) => [i, j, Number((em.efficiency_u[i][j] * 100).toFixed(4))]));
   check(uMap.length === 4 && JSON.stringify(uMap) === JSON.stringify(wantU) && await page.$eval('#r-map-u', (e) => e.getAttribute('aria-pressed')) === 'true',
     `"map of u" draws the efficiency's u per cell (${JSON.stringify(uMap[0])})`);
   await page.$eval('[data-chart="r-map"]', (e) => e.scrollIntoView());

@@ -14,8 +14,14 @@ export function setToken(t) { token = t; }
 export function getToken() { return token; }
 export function setUnauthorizedHandler(fn) { onUnauthorized = fn; }
 
+// Routes the daemon answers without a token; every other request waits for a sign-in.
+const PUBLIC = new Set(['/api/health']);
+
 // api('GET', '/api/sweeps') -> parsed JSON (or text with {text: true}).
 export async function api(method, path, body, { text = false, quiet401 = false, timeoutMs = 10000 } = {}) {
+  // Before a sign-in nothing is asked of the daemon (a 401 would open the sign-in dialog over a
+  // page that is about to sign in with its saved token): the caller gets the refusal locally.
+  if (!token && !PUBLIC.has(path.split('?')[0])) throw new ApiError(401, 'signed_out', 'not signed in');
   const headers = {};
   if (token) headers.Authorization = `Bearer ${token}`;
   if (body !== undefined) headers['Content-Type'] = 'application/json';

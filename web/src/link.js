@@ -166,7 +166,7 @@ export function statusToTelemetry(st) {
     type: 'telemetry', source: 'rest', t_s: st.t_s, enabled: st.enabled, phase: st.supervisor?.phase,
     speed_rpm: s.speed_rpm ?? null, torque_Nm: st.load?.torque_Nm ?? null,
     im_A: s.im_A ?? null, id_A: s.id_A ?? null, iq_A: s.iq_A ?? null, udc_V: s.udc_V ?? null,
-    pdc_W: s.pdc_W ?? null, pac_W: s.pac_W ?? null, temp_C: s.temp_C ?? null, pos_err_deg: s.pos_err_deg ?? null,
+    pac_W: s.pac_W ?? null, pdcm_W: s.pdcm_W ?? null, temp_C: s.temp_C ?? null, pos_err_deg: s.pos_err_deg ?? null,
     voltage_limited: !!s.voltage_limited, lock_lost: !!s.lock_lost, fault,
   };
 }

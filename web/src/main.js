@@ -112,6 +112,9 @@ function renderBenchPills(st) {
   else if (!st.synrm) { state = 'bad'; text = 'link down'; }
   b.dataset.state = state;
   b.textContent = text;
+  // A drive the daemon could not read: why, in the daemon's words (the last read's error).
+  const unread = [['SynRM drive', st.synrm_error], ['load drive', st.load_error]].filter(([, e]) => e);
+  b.title = unread.map(([d, e]) => `${d} not read: ${e}`).join('\n');
   document.body.dataset.bench = state;
   const trip = st.supervisor?.trip;
   const alarm = st.supervisor?.alarm;
@@ -126,10 +129,12 @@ function renderBenchPills(st) {
   if (alarm) { f.dataset.state = 'tripped'; f.textContent = 'ALARM: drive not stopped'; f.title = alarm.detail; }
   else if (trip) { f.dataset.state = 'tripped'; f.textContent = `tripped: ${faultText(trip.fault, trip.fault_code_raw)}`; f.title = trip.detail || ''; }
   else if (driveFault) { f.dataset.state = 'bad'; f.textContent = `fault: ${driveFault}`; }
-  else if (st.synrm?.lock_lost) {
+  // The drive's lock flag holds until a setpoint change: true of a running drive, stale for a
+  // stopped one (it runs on no estimator at all), so it is shown only while the SynRM runs.
+  else if (st.synrm?.lock_lost && st.synrm.state === 'running') {
     f.dataset.state = 'warn'; f.textContent = 'lock lost: on the encoder';
     f.title = 'the estimator left the encoder angle; the drive runs on the encoder until the speed or angle setpoint changes';
-  } else if (st.synrm?.voltage_limited) { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
+  } else if (st.synrm?.voltage_limited && st.synrm.state === 'running') { f.dataset.state = 'warn'; f.textContent = 'voltage limited'; }
   else { f.dataset.state = 'ok'; f.textContent = 'no fault'; }
 }
 
@@ -185,6 +190,7 @@ async function signIn(token, remember) {
   renderRole();
   startLink();
   await app.refreshAll();
+  route(); // the view shown since the page loaded now reads its data, with the token
 }
 
 function showSignIn(message = '') {
@@ -237,6 +243,10 @@ setInterval(() => {
 }, 1000);
 
 // ---- routing and shortcuts --------------------------------------------------------------------
+// A view is told it is shown ('view', which makes it read its data) only once a sign-in has set
+// the token: routed before, it would ask the daemon without one, and the 401 would open the
+// sign-in dialog over a page about to sign in with its saved token (a reload, a link in a new
+// tab). signIn() routes again when it is done.
 const VIEWS = ['live', 'sweep', 'results', 'history'];
 function route() {
   const m = /^#\/(\w+)(?:\/(\d+))?/.exec(location.hash);
@@ -246,7 +256,7 @@ function route() {
   for (const a of document.querySelectorAll('[data-nav]')) {
     if (a.dataset.nav === view) a.setAttribute('aria-current', 'page'); else a.removeAttribute('aria-current');
   }
-  app.emit('view', { view, arg: m?.[2] ? Number(m[2]) : null });
+  if (app.role) app.emit('view', { view, arg: m?.[2] ? Number(m[2]) : null });
 }
 
 // An E-stop the daemon did not confirm within this: the page says so loudly, at once.

@@ -22,13 +22,16 @@ const CHARTS = [
   { id: 'angle', title: 'Current angle θ_i', unit: 'deg', series: [['theta_i_deg', 'measured'], ['cmd_angle_deg', 'setpoint', true]], d: 1, span: 5 },
   { id: 'currents', title: 'Currents', unit: 'A', series: [['im_A', 'I_m'], ['id_A', 'i_d'], ['iq_A', 'i_q']], d: 2, span: 0.5 },
   { id: 'udc', title: 'DC bus U_dc', unit: 'V', series: [['udc_V', 'U_dc']], d: 1, span: 10 },
-  { id: 'pdc', title: 'P_dcM', unit: 'W', series: [['pdc_W', 'P_dcM']], d: 1, span: 20 },  // falls back to the drive's P_ac estimate
+  // Each power as what it is: the drive's own estimate P_ac (telemetry pac_W), and the VFC meter's
+  // P_dcM (pdcm_W) only when the daemon sends it live (today's measures it over a point's window).
+  { id: 'power', title: 'Power', unit: 'W', series: [['pac_W', 'P_ac (drive estimate)'], ['pdcm_W', 'P_dcM (meter)']], d: 1, span: 20,
+    short: ['P_ac', 'P_dcM'] },
   { id: 'temp', title: 'Winding temperature', unit: '°C', series: [['temp_C', 'temperature']], d: 1, span: 2 },
   { id: 'poserr', title: 'Position error', unit: 'deg', series: [['pos_err_deg', 'θ̂ − θ']], d: 2, span: 1, empty: 'no live position error (the encoder is the source, or the daemon does not send it)' },
 ];
 // The CSV's columns: the sample's keys carry their units.
 const CSV_COLUMNS = ['t_s', 'speed_rpm', 'cmd_speed_rpm', 'torque_Nm', 'cmd_load_Nm', 'theta_i_deg', 'cmd_angle_deg', 'im_A', 'id_A', 'iq_A',
-  'udc_V', 'pdc_W', 'temp_C', 'pos_err_deg'].map((k) => [k, k]);
+  'udc_V', 'pac_W', 'pdcm_W', 'temp_C', 'pos_err_deg'].map((k) => [k, k]);
 
 // The measured current angle atan2(|i_q|, i_d) (docs/record.md angle_meas_deg); none below 0.1 A.
 const thetaI = (id, iq) => (id == null || iq == null || Math.hypot(id, iq) < 0.1 ? null : (Math.atan2(Math.abs(iq), id) * 180) / Math.PI);
@@ -55,6 +58,7 @@ export class LiveView {
       host.append(div);
       this.cards.set(c.id, new ChartCard(div, { title: `${c.title} [${c.unit}]` }));
     }
+    this.titlePower(false);
     this.fillEstimators(false);
     app.on('telemetry', (t) => this.onTelemetry(t));
     app.on('status', (st) => this.onStatus(st));
@@ -116,17 +120,9 @@ export class LiveView {
     }
     this.lastT = t.t_s;
     const cmd = this.app.status?.commanded || {};
-    // Live P_dcM when the daemon sends it; else the drive's own output-power estimate P_ac
-    // (the VFC meter measures P_dcM only over a point's window).
-    const pdcLive = t.pdc_W != null;
-    if (pdcLive !== this.pdcLive) {
-      this.pdcLive = pdcLive;
-      const h = this.cards.get('pdc').h;
-      h.textContent = pdcLive ? 'P_dcM [W]' : 'Drive power P_ac [W]';
-      h.title = pdcLive ? 'DC power into the SynRM drive' : 'The drive\'s own output-power estimate: the daemon sends no live P_dcM (the VFC meter measures it over each point\'s window)';
-    }
+    this.titlePower(t.pdcm_W != null);
     const sample = {
-      ...t, pdc_W: t.pdc_W ?? t.pac_W ?? null, theta_i_deg: thetaI(t.id_A, t.iq_A),
+      ...t, pac_W: t.pac_W ?? null, pdcm_W: t.pdcm_W ?? null, theta_i_deg: thetaI(t.id_A, t.iq_A),
       cmd_speed_rpm: t.cmd_speed_rpm ?? cmd.speed_rpm, cmd_load_Nm: t.cmd_load_Nm ?? cmd.load_Nm, cmd_angle_deg: t.cmd_angle_deg ?? cmd.angle_deg,
     };
     this.buf.push(sample);
@@ -134,6 +130,17 @@ export class LiveView {
     if (this.buf.length > 50 && this.buf[0].t_s < cut) this.buf = this.buf.filter((s) => s.t_s >= cut);
     this.latest = sample;
     this.dirty = true;
+  }
+
+  // The power chart says which power it draws: the drive's estimate P_ac, and the meter's P_dcM
+  // only while the daemon sends it (never the one labelled as the other).
+  titlePower(meterLive) {
+    if (meterLive === this.meterLive) return;
+    this.meterLive = meterLive;
+    const h = this.cards.get('power').h;
+    h.textContent = meterLive ? 'Power: P_dcM (meter), P_ac (drive estimate) [W]' : 'Drive power P_ac [W] (estimate; no live P_dcM)';
+    h.title = meterLive ? 'P_dcM: DC power into the SynRM drive, the VFC meter; P_ac: the drive\'s own output-power estimate'
+      : 'The drive\'s own output-power estimate 1.5 (u_d i_d + u_q i_q): the daemon sends no live P_dcM (the VFC meter measures it over each point\'s window)';
   }
 
   // The daemon's telemetry ring (GET /api/telemetry/history): the charts full at once on load,
@@ -147,7 +154,7 @@ export class LiveView {
     const rows = h.t_s.map((t, i) => {
       const s = { t_s: t, source: 'history' };
       for (const k of Object.keys(c)) s[k] = c[k][i];
-      s.pdc_W = s.pdc_W ?? s.pac_W ?? null;
+      s.pdcm_W = s.pdcm_W ?? null; // the meter's, only when the daemon keeps it
       s.theta_i_deg = thetaI(s.id_A, s.iq_A);
       return s;
     });
@@ -208,8 +215,13 @@ export class LiveView {
       }
       card.card.dataset.firstX = rows.length ? String(rows[0].t_s) : '';
       card.card.dataset.lastX = rows.length ? String(rows[rows.length - 1].t_s) : '';
-      const v = this.latest?.[c.series[0][0]];
-      card.value(v == null ? '–' : `${fmt(v, c.d)} ${c.unit}`);
+      if (c.short) { // different quantities in one chart: each named, those with a value
+        const parts = c.series.map(([key], i) => [c.short[i], this.latest?.[key]]).filter(([, x]) => x != null);
+        card.value(parts.length ? parts.map(([n, x]) => `${n} ${fmt(x, c.d)} ${c.unit}`).join(' · ') : '–');
+      } else {
+        const v = this.latest?.[c.series[0][0]];
+        card.value(v == null ? '–' : `${fmt(v, c.d)} ${c.unit}`);
+      }
     }
     this.scope.renderCursors();
   }
@@ -224,6 +236,7 @@ export class LiveView {
 
   onStatus(st) {
     this.status = st;
+    this.noteEnabled(st);
     this.renderReadout();
     this.feed.update(st);
     const f = $('#setpoints-form');
@@ -265,14 +278,42 @@ export class LiveView {
         ? `${fmt(st.commanded.speed_rpm, 0)} rpm, ${fmt(st.commanded.load_Nm, 2)} N m, ${fmt(st.commanded.angle_deg, 1)}°`
         : `${fmt(st.setpoints?.speed_rpm, 0)} rpm, ${fmt(st.setpoints?.load_Nm, 2)} N m, ${fmt(st.setpoints?.angle_deg, 1)}°`],
     ];
-    if (st.mode || st.estimator) rows.push(['estimator', `${st.mode?.estimator || st.estimator} / ${st.mode?.pwm || st.pwm || ''}`]);
+    const drive = this.driveConfig(st);
+    if (drive) rows.push(['estimator / PWM', drive]);
     if (st.supervisor?.trip) rows.push(['trip', `${faultText(st.supervisor.trip.fault, st.supervisor.trip.fault_code_raw)}: ${st.supervisor.trip.detail}`]);
     if (st.supervisor?.alarm) rows.push(['ALARM', st.supervisor.alarm.detail]);
+    // A stop's confirmation belongs to that stop: it goes once the drives were enabled after it.
     const dis = st.supervisor?.disable;
-    if (dis) rows.push(['disable', disableText(dis)]);
+    if (dis && !(this.enabledSeenAt > dis.at_s)) rows.push(['disable', disableText(dis)]);
     if (st.heartbeats === false) rows.push(['heartbeats', "stopped until reset: the drives' watchdogs are armed"]);
     const html = rows.map(([k, val]) => `<dt>${k}</dt><dd data-k="${k}">${escapeHtml(String(val))}</dd>`).join('');
     if (html !== this.readoutHtml) { this.readoutHtml = html; $('#readout').innerHTML = html; }
+  }
+
+  // What the SynRM drive runs (or runs on Enable): while a sweep owns the bench its point's
+  // configuration (the point procedure writes it before it enables), between two points the last
+  // point's; else the manual mode (status mode), which Enable writes. The daemon's status says
+  // which configuration it commands only through these two (no field for what the drive was last
+  // set to), so between sweeps and manual runs the page does not guess.
+  driveConfig(st) {
+    const sw = st.sweep;
+    if (sweepActive(st)) {
+      if (sw.point) { this.lastPoint = { id: sw.id, ...sw.point }; return `${sw.point.estimator} / ${sw.point.pwm} (sweep point)`; }
+      const last = this.lastPoint?.id === sw.id ? this.lastPoint : null;
+      return last ? `${last.estimator} / ${last.pwm} (the sweep's last point; none in flight)` : '– (the sweep has no point in flight yet)';
+    }
+    const m = st.mode || (st.estimator ? { estimator: st.estimator, pwm: st.pwm } : null);
+    if (!m) return null;
+    return st.enabled ? `${m.estimator} / ${m.pwm}` : `${m.estimator} / ${m.pwm} (manual, on Enable)`;
+  }
+
+  // The drives are enabled now (by hand, or by a sweep's point in flight): remembered as the
+  // bench time, so a stop's disable report older than it is not shown as news.
+  noteEnabled(st) {
+    // (phase normal: a status published in the tick of a trip or E-stop does not count)
+    const on = (st.supervisor?.phase ?? 'normal') === 'normal' && !st.stopping
+      && (st.enabled || (sweepActive(st) && st.sweep.current_index != null && st.sweep.point != null));
+    if (on && Number.isFinite(st.t_s)) this.enabledSeenAt = Math.max(this.enabledSeenAt ?? -Infinity, st.t_s);
   }
 
   // Events from the status (the most recent 50) and pushed over the socket, each once.

@@ -2,6 +2,7 @@
 // is the analysis JSON (docs/analysis.md) or the points JSON (docs/record.md).
 import { axis, PALETTE } from '../charts.js';
 import { errorBarSeries, pm, fmtU, known, BARS_NOTE, NO_U_NOTE, FADED, FADED_NOTE } from '../errorbars.js';
+import { etaRangePct, etaVisualMap } from '../eta_scale.js';
 
 const r2 = (v, d = 2) => (v == null || !Number.isFinite(v) ? null : Number(v.toFixed(d)));
 export const sameCfg = (a, b) => a && b && a.estimator === b.estimator && a.pwm === b.pwm;
@@ -16,8 +17,10 @@ const uTooltip = (unitOf, digits) => (params) => [].concat(params).filter((p) =>
     + `${pm(Array.isArray(p.value) ? p.value[1] : p.value, p.data?.u, unitOf(p), digits(p))}${p.data?.significant === false ? ' — not significant at 95 %' : ''}`)
   .join('<br>');
 
-// Efficiency map (P_m / P_dcM at the ME angle) over load x speed, as a heat map with values.
-// showU: the map of the efficiency's standard uncertainty u (percentage points) instead of η.
+// Efficiency map (P_m / P_dcM at the ME angle) over speed (x) x load torque (y), as the contour
+// map and the report draw it, a heat map with the value in each cell, in the one colour scale of
+// every efficiency map (eta_scale.js). showU: the map of the efficiency's standard uncertainty u
+// (percentage points) instead of η, in a scale of its own (another quantity).
 export function effMapOption(analysis, cfg, showU = false) {
   const e = (analysis?.efficiency_map?.entries || []).find((x) => sameCfg(x, cfg)) || analysis?.efficiency_map?.entries?.[0];
   if (!e) return { series: [] };
@@ -26,23 +29,24 @@ export function effMapOption(analysis, cfg, showU = false) {
     const v = e.efficiency[i]?.[j];
     const u = e.efficiency_u?.[i]?.[j];
     const shown = showU ? (known(u) ? r2(u * 100, 4) : null) : r2(v * 100, 1);
-    if (v != null && shown != null) data.push({ value: [j, i, shown], eta: v, u: known(u) ? u : null, ur: e.efficiency_u_repeat?.[i]?.[j] ?? null });
+    if (v != null && shown != null) data.push({ value: [i, j, shown], eta: v, u: known(u) ? u : null, ur: e.efficiency_u_repeat?.[i]?.[j] ?? null });
   }));
   const vals = data.map((d) => d.value[2]);
-  const tip = (p) => `${e.speeds_rpm[p.value[1]]} rpm, ${e.loads_Nm[p.value[0]]} N m<br>η = ${known(p.data.u) ? `${(p.data.eta * 100).toFixed(2)} ± ${fmtU(p.data.u * 100)} % (k=1)`
+  const tip = (p) => `${e.speeds_rpm[p.value[0]]} rpm, ${e.loads_Nm[p.value[1]]} N m<br>η = ${known(p.data.u) ? `${(p.data.eta * 100).toFixed(2)} ± ${fmtU(p.data.u * 100)} % (k=1)`
     + `${known(p.data.ur) ? `<br>point-to-point part ${fmtU(p.data.ur * 100)} %` : ''}` : `${(p.data.eta * 100).toFixed(1)} % (${NO_U_NOTE})`}`;
-  const lo = vals.length ? Math.min(...vals) : 0, hi = vals.length ? Math.max(...vals) : 100;
+  const hi = vals.length ? Math.max(...vals) : 1;
+  const cat = (name, values, gap) => ({ type: 'category', name, nameLocation: 'middle', nameGap: gap, data: values.map(String),
+    axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } });
   return {
     title: { ...uNote([]), text: !data.some((d) => d.u != null) ? NO_U_NOTE : showU ? 'u(η) per cell, percentage points (k=1)' : 'tooltip: η ± u (k=1)' },
     tooltip: { trigger: 'item', formatter: tip },
     grid: { left: 64, right: 80, top: 24, bottom: 40 },
-    xAxis: { type: 'category', name: 'load torque T_L [N m]', nameLocation: 'middle', nameGap: 26, data: e.loads_Nm.map(String),
-      axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
-    yAxis: { type: 'category', name: 'speed [rpm]', nameLocation: 'middle', nameGap: 44, data: e.speeds_rpm.map(String),
-      axisLabel: { color: '#333b47' }, nameTextStyle: { color: '#333b47', fontWeight: 600 } },
-    visualMap: { dimension: 2, precision: showU ? 2 : 0, min: showU ? 0 : Math.floor(lo / 5) * 5, max: showU ? (hi > 0 ? hi : 1) : vals.length ? Math.ceil(hi / 5) * 5 : 100,
-      calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160, text: [showU ? 'u(η) %' : 'η %', ''], textStyle: { color: '#14181f' },
-      inRange: { color: showU ? ['#ffffe5', '#fee391', '#fe9929', '#cc4c02', '#662506'] : ['#313695', '#4575b4', '#74add1', '#abd9e9', '#fee090', '#fdae61', '#f46d43', '#a50026'] } },
+    xAxis: cat('speed [rpm]', e.speeds_rpm, 26),
+    yAxis: cat('load torque T_L [N m]', e.loads_Nm, 40),
+    visualMap: showU
+      ? { dimension: 2, precision: 2, min: 0, max: hi > 0 ? hi : 1, calculable: true, orient: 'vertical', right: 4, top: 'middle', itemHeight: 160,
+        text: ['u(η) %', ''], textStyle: { color: '#14181f' }, inRange: { color: ['#ffffe5', '#fee391', '#fe9929', '#cc4c02', '#662506'] } }
+      : etaVisualMap(etaRangePct(e), 2),
     series: [{ name: `${showU ? 'u of the efficiency' : 'efficiency'} ${cfgLabel(e)}`, type: 'heatmap', data,
       label: { show: data.length <= 80, color: '#000', textBorderColor: '#fff', textBorderWidth: 2, fontWeight: 600, formatter: (p) => (showU ? fmtU(p.value[2]) : p.value[2].toFixed(1)) },
       emphasis: { itemStyle: { borderColor: '#000', borderWidth: 1 } } }],

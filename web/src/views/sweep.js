@@ -2,7 +2,7 @@
 // plan checked against the bench's limits) and the progress of the current sweep (per-point
 // status cells, keyboard-reachable; ETA; abort with a reason; efficiency map and trajectories
 // filling in as points complete).
-import { api, ApiError } from '../api.js';
+import { api, ApiError, getToken } from '../api.js';
 import { ChartCard } from '../charts.js';
 import { ESTIMATORS, benchLimitErrors, describePlan, expandGroups, expandPlan, fmtDuration, values } from '../plan.js';
 import { effMapOption, trajectoriesOption, cfgLabel } from './plots.js';
@@ -69,7 +69,7 @@ export class SweepView {
     app.on('sweep-progress', (s) => this.onProgress(s));
     app.on('refresh', () => { this.refreshCurrent(true); if (!this.presetsFromDaemon) this.loadPresets(true); this.loadBenchConfig(); });
     // Signed in (or the role changed): what was refused before the token is asked again.
-    app.on('role', () => { this.renderButtons(); this.loadBenchConfig(); this.changed(); });
+    app.on('role', () => { this.renderButtons(); if (app.role) this.loadBenchConfig(); this.changed(); });
     setInterval(() => { if (this.visible && this.current && ACTIVE.includes(this.current.state)) this.refreshCurrent(false); }, 2000);
   }
 
@@ -302,6 +302,14 @@ export class SweepView {
     const el = $('#b-estimate');
     const seq = (this.estSeq = (this.estSeq || 0) + 1);
     let text, bad = false, errors = benchLimitErrors(plan, this.benchConfig);
+    if (!getToken()) {
+      // Nothing is sent before a sign-in; signing in asks again (the 'role' event).
+      el.textContent = 'sign in to estimate: no plan is sent to the daemon without a token';
+      el.classList.remove('bad');
+      el.dataset.points = '';
+      this.showPlanErrors(errors);
+      return;
+    }
     try {
       const r = await api('POST', '/api/sweeps/estimate', plan, { quiet401: true });
       text = `${r.points}${r.upper_bound || plan.mode === 'adaptive' ? ' points at most' : ' points'}, about ${fmtDuration(r.duration_s)} of bench time`;
