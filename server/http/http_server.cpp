@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <boost/asio/strand.hpp>
@@ -172,7 +173,9 @@ class Session : public std::enable_shared_from_this<Session> {
     if (ec) return on_read(ec, n);
     if (const auto bad = framing_problem(parser_->get()))
       return send_error(bad->status, bad->status == 501 ? "not_implemented" : "bad_request", bad->message, false);
-    header_ = parser_->get().base();
+    // Only a chunked body can carry trailer fields: only then is the header section kept apart.
+    header_kept_ = parser_->chunked();
+    if (header_kept_) header_ = parser_->get().base();
     if (parser_->is_done()) return on_read({}, 0);
     bhttp::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&Session::on_read, shared_from_this()));
   }
@@ -195,7 +198,7 @@ class Session : public std::enable_shared_from_this<Session> {
     // client. The request is answered 500 and the line on stderr says what was caught.
     try {
       auto req = parser_->release();
-      req.base() = std::move(header_);  // the header section only: trailer fields are dropped
+      if (header_kept_) req.base() = std::move(header_);  // the header section only: trailer fields are dropped
       handle(std::move(req));
     } catch (const std::exception& e) {
       std::cerr << "synbench serve: internal error answering a request: " << drivers::escape_invalid_utf8(e.what()) << "\n";
@@ -205,9 +208,12 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void handle(bhttp::request<bhttp::string_body> req) {
     const bool keep_alive = req.keep_alive() && !shared_->closing;
-    if (req.count(bhttp::field::authorization)) {
-      const auto a = req[bhttp::field::authorization];
+    // The connection's trust (whom eviction spares) from its token: the same header as this
+    // connection's last request needs no second digest (the router still checks every request).
+    if (const auto a = req[bhttp::field::authorization];
+        req.count(bhttp::field::authorization) && (trusted_authorization_.empty() || std::string_view(a.data(), a.size()) != trusted_authorization_)) {
       const auto who = shared_->router.identify(std::string_view(a.data(), a.size()));
+      if (who) trusted_authorization_.assign(a.data(), a.size());
       if (!who) log_failed_sign_in(client_, std::string(req.method_string()) + " " + std::string(req.target().substr(0, 80)));
       const Trust t = trust_of(who);
       if (static_cast<int>(t) > static_cast<int>(trust_)) {
@@ -239,13 +245,27 @@ class Session : public std::enable_shared_from_this<Session> {
       const auto auth = req[bhttp::field::authorization];
       // A bench command answers from the bench thread once it has acted: the answer comes back
       // to this session's strand, and the io thread serves others meanwhile.
+      // A route that answers at once (most) is answered right here, without a second trip
+      // through the io loop; only an answer from another thread is posted back to the strand.
       const Meta meta{method, path, req.version(), keep_alive, req.method() == bhttp::verb::head};
+      const std::uint64_t seq = ++dispatch_seq_;
+      dispatching_ = seq;
       shared_->router.dispatch_async(method, target, std::string_view(auth.data(), auth.size()), std::move(req.body()),
-                                     [self = shared_from_this(), meta](Response answer) {
+                                     [self = shared_from_this(), meta, seq, here = std::this_thread::get_id()](Response answer) {
+                                       if (std::this_thread::get_id() == here && self->dispatching_ == seq) {
+                                         self->sync_answer_ = std::move(answer);
+                                         return;
+                                       }
                                        net::post(self->stream_.get_executor(), [self, meta, answer = std::move(answer)]() mutable {
                                          self->respond(meta, std::move(answer));
                                        });
                                      });
+      dispatching_ = 0;
+      if (sync_answer_) {
+        Response answer = std::move(*sync_answer_);
+        sync_answer_.reset();
+        respond(meta, std::move(answer));
+      }
       return;
     } else {
       // The dashboard's files need no token: the page signs in itself.
@@ -324,11 +344,17 @@ class Session : public std::enable_shared_from_this<Session> {
 
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
-  bhttp::request_header<> header_;  // the request's header section, as read before its body
+  bhttp::request_header<> header_;  // a chunked request's header section, as read before its body
+  bool header_kept_ = false;
   std::shared_ptr<HttpServer::Shared> shared_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
   std::shared_ptr<ConnectionSlot> slot_;  // empty for a connection refused at the door
   Trust trust_ = Trust::none;
+  std::string trusted_authorization_;  // the last Authorization header that identified a caller
+  // The dispatch under way on this thread (0: none), and its answer when the route gave it
+  // before dispatch_async returned.
+  std::uint64_t dispatch_seq_ = 0, dispatching_ = 0;
+  std::optional<Response> sync_answer_;
   std::string client_;  // the peer's address
   bool draining_ = false;
   std::size_t drained_ = 0;

@@ -33,8 +33,10 @@ struct ServerLimits {
   double unauthenticated_timeout_s = 5;
   // Beyond either, the oldest least trusted connection below an operator's is closed to make
   // room (connection_registry.hpp); only when operators hold them all is the new one refused.
-  std::size_t max_connections = 64;
-  std::size_t max_connections_per_client = 48;  // one client address's share
+  // Dashboards, Prometheus and scripts poll together, behind a reverse proxy all from one
+  // address: 64 connections from one client fit without an eviction.
+  std::size_t max_connections = 256;
+  std::size_t max_connections_per_client = 192;  // one client address's share
 };
 
 // Host header values accepted for a server listening on host:port: "host:port", and for a

@@ -1,6 +1,7 @@
 // Route matching, bearer auth and the OpenAPI document of the route table.
 #include "server/http/router.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <future>
@@ -97,14 +98,32 @@ std::map<std::string, std::string> parse_query(std::string_view query) {
   return out;
 }
 
+namespace {
+
+// The next non-empty '/'-separated segment of `s` from `pos` into `seg`; false at the end.
+bool next_segment(std::string_view s, std::size_t& pos, std::string_view& seg) {
+  while (pos < s.size() && s[pos] == '/') ++pos;
+  if (pos >= s.size()) return false;
+  const std::size_t end = std::min(s.find('/', pos), s.size());
+  seg = s.substr(pos, end - pos);
+  pos = end;
+  return true;
+}
+
+}  // namespace
+
+// Walks both strings segment by segment: every request tries the routes in turn, and a route
+// that does not match costs no allocation.
 bool match_pattern(std::string_view pattern, std::string_view path, std::map<std::string, std::string>& params) {
-  const auto p = segments(pattern), s = segments(path);
-  if (p.size() != s.size()) return false;
+  std::size_t pi = 0, si = 0;
+  std::string_view p, s;
   std::map<std::string, std::string> found;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p[i].size() > 2 && p[i].front() == '{' && p[i].back() == '}')
-      found[std::string(p[i].substr(1, p[i].size() - 2))] = decode(s[i]);
-    else if (p[i] != s[i]) return false;
+  for (;;) {
+    const bool more_p = next_segment(pattern, pi, p), more_s = next_segment(path, si, s);
+    if (more_p != more_s) return false;
+    if (!more_p) break;
+    if (p.size() > 2 && p.front() == '{' && p.back() == '}') found[std::string(p.substr(1, p.size() - 2))] = decode(s);
+    else if (p != s) return false;
   }
   params = std::move(found);
   return true;
@@ -205,8 +224,8 @@ void Router::route_and_call(const std::string& method, const std::string& target
   req.path = target.substr(0, q);
   if (q != std::string::npos) req.query = parse_query(std::string_view(target).substr(q + 1));
   req.body = std::move(body);
-  // The path is echoed in messages; a byte that is not UTF-8 is shown as \xNN.
-  const std::string shown_path = drivers::escape_invalid_utf8(req.path);
+  // The path is echoed in messages (only those); a byte that is not UTF-8 is shown as \xNN.
+  const auto shown_path = [&req] { return drivers::escape_invalid_utf8(req.path); };
 
   const Route* route = nullptr;
   std::set<std::string> allowed;
@@ -222,11 +241,11 @@ void Router::route_and_call(const std::string& method, const std::string& target
     }
   }
   if (!route) {
-    if (allowed.empty()) return reply(error_response(404, "not_found", "no route for " + shown_path));
+    if (allowed.empty()) return reply(error_response(404, "not_found", "no route for " + shown_path()));
     std::string allow;
     for (const auto& m : allowed) allow += (allow.empty() ? "" : ", ") + m;
     Response r = error_response(405, "method_not_allowed",
-                                drivers::escape_invalid_utf8(method) + " is not allowed on " + shown_path + " (allowed: " + allow + ")");
+                                drivers::escape_invalid_utf8(method) + " is not allowed on " + shown_path() + " (allowed: " + allow + ")");
     r.headers.emplace_back("Allow", allow);
     return reply(std::move(r));
   }

@@ -51,12 +51,12 @@ std::string sha256_hex(std::string_view data) {
   for (int i = 7; i >= 0; --i) msg.push_back(static_cast<char>((bits >> (8 * i)) & 0xff));
   for (std::size_t off = 0; off < msg.size(); off += 64)
     compress(h, reinterpret_cast<const unsigned char*>(msg.data() + off));
-  std::string out;
-  char buf[9];
-  for (std::uint32_t v : h) {
-    std::snprintf(buf, sizeof buf, "%08x", v);
-    out += buf;
-  }
+  // Every request's token is hashed: hex digits from a table, not 8 snprintf calls.
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out(64, '0');
+  std::size_t k = 0;
+  for (std::uint32_t v : h)
+    for (int shift = 28; shift >= 0; shift -= 4) out[k++] = kHex[(v >> shift) & 0xf];
   return out;
 }
 

@@ -3,6 +3,7 @@
 // constant time, and reloaded when the file changes so `synbench token create` needs no restart.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <mutex>
 #include <optional>
@@ -37,12 +38,18 @@ class TokenStore {
   std::string load_error() const;
   bool empty() const;
   // Role of `token` and its label ("token-" + 8 digits of its digest), or nullopt. Reloads the
-  // file first when its modification time changed.
+  // file first when its modification time changed: looked at every kRecheck, and at once for a
+  // token that matches none.
   std::optional<Identity> authenticate(std::string_view token);
+  static constexpr std::chrono::milliseconds kRecheck{50};
   const std::filesystem::path& file() const { return file_; }
 
  private:
   std::error_code load_locked();
+  // Stats the file (reloading it when it changed) and schedules the next look; returns true.
+  bool reload_if_changed(std::chrono::steady_clock::time_point now);
+  std::optional<Identity> match(const std::string& digest) const;  // over every entry, constant time
+  std::chrono::steady_clock::time_point next_check_{};
   std::filesystem::path file_;
   mutable std::mutex mutex_;
   std::vector<TokenEntry> entries_;

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <algorithm>
+#include <thread>
 #include <gtest/gtest.h>
 
 #include "server/http/sha256.hpp"
@@ -82,6 +84,32 @@ TEST(Tokens, ReloadsWhenAnotherProcessAddsOne) {
   ASSERT_FALSE(ec);
   ASSERT_TRUE(daemon.authenticate(added));
   EXPECT_EQ(daemon.authenticate(added)->role, Role::viewer);
+  std::filesystem::remove_all(dir);
+}
+
+// A token removed by another process (revoked) is refused once the daemon's store has looked at
+// the file again: within TokenStore::kRecheck of the change, not on a stat per request.
+TEST(Tokens, ARevokedTokenIsRefusedWithinTheRecheck) {
+  const auto dir = temp_dir();
+  TokenStore daemon(dir / "tokens.json");
+  std::error_code ec;
+  const auto op = daemon.create(Role::operator_, ec);
+  ASSERT_FALSE(ec);
+  TokenStore cli(dir / "tokens.json");
+  std::filesystem::last_write_time(dir / "tokens.json", std::filesystem::file_time_type::clock::now() - std::chrono::hours(1));
+  const auto view = cli.create(Role::viewer, ec);
+  ASSERT_FALSE(ec);
+  ASSERT_TRUE(daemon.authenticate(view));  // an unknown token looks at once
+  ASSERT_TRUE(daemon.authenticate(op));
+  // Revoked: the file holds the operator's token only.
+  std::filesystem::last_write_time(dir / "tokens.json", std::filesystem::file_time_type::clock::now() - std::chrono::hours(2));
+  auto doc = synbench::Json::parse(std::ifstream(dir / "tokens.json"));
+  auto& list = doc["tokens"];
+  list.erase(std::remove_if(list.begin(), list.end(), [](const auto& t) { return t["role"] == "viewer"; }), list.end());
+  std::ofstream(dir / "tokens.json") << doc.dump();
+  std::this_thread::sleep_for(TokenStore::kRecheck + std::chrono::milliseconds(20));
+  EXPECT_FALSE(daemon.authenticate(view)) << "revoked, refused after the recheck";
+  EXPECT_TRUE(daemon.authenticate(op));
   std::filesystem::remove_all(dir);
 }
 
