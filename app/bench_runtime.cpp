@@ -280,6 +280,14 @@ void BenchRuntime::zero_held_setpoints() {
   event("setpoints", "zeroed by the trip: speed 0 rpm, load 0 Nm, angle " + drivers::format_number(setpoints_.angle_deg) + " deg");
 }
 
+std::optional<Refusal> BenchRuntime::tripped_refusal() const {
+  if (!supervisor_->tripped()) return std::nullopt;
+  // In an operator's words (a dashboard shows it as it is): what tripped, and what to do.
+  const auto& t = *supervisor_->trip();
+  return Refusal{Refused::tripped, "the bench is tripped (" + std::string(drivers::fault_name(t.fault)) + ": " + t.detail +
+                                       "): reset the trip first, once the cause is cleared"};
+}
+
 std::optional<Refusal> BenchRuntime::busy_with_sweep() const {
   if (!sweep_) return std::nullopt;
   return Refusal{Refused::sweep_running, "sweep " + std::to_string(sweep_->id()) + " drives the bench; abort it first"};
@@ -312,8 +320,7 @@ void BenchRuntime::enable(bool on, Done done) {
       [this, on](double now_s) -> std::optional<Refusal> {
         if (auto r = busy_with_sweep()) return r;
         if (!on) return begin_disable(now_s);
-        if (supervisor_->tripped())
-          return Refusal{Refused::tripped, "the safety supervisor has tripped; POST /api/bench/reset first"};
+        if (auto r = tripped_refusal()) return r;
         if (supervisor_->alarm())
           return Refusal{Refused::drive_running, "alarm: " + supervisor_->alarm()->detail + "; reset first"};
         if (enabled_ && !stop_.active()) return std::nullopt;
@@ -343,8 +350,7 @@ void BenchRuntime::enable(bool on, Done done) {
 void BenchRuntime::set_setpoints(SetpointsUpdate update, Done done) {
   submit(
       [this, update](double) -> std::optional<Refusal> {
-        if (supervisor_->tripped())
-          return Refusal{Refused::tripped, "the safety supervisor has tripped; POST /api/bench/reset first"};
+        if (auto r = tripped_refusal()) return r;
         if (auto r = busy_with_sweep()) return r;
         if (update.speed_rpm) setpoints_.speed_rpm = *update.speed_rpm;
         if (update.load_Nm) setpoints_.load_Nm = *update.load_Nm;
@@ -407,8 +413,7 @@ void BenchRuntime::start_sweep(std::int64_t id, bench::SweepPlan plan, std::map<
                                                                                                        std::move(stored));
   submit(
       [this, id, shared, db_path](double) -> std::optional<Refusal> {
-        if (supervisor_->tripped())
-          return Refusal{Refused::tripped, "the safety supervisor has tripped; POST /api/bench/reset first"};
+        if (auto r = tripped_refusal()) return r;
         if (sweep_) return Refusal{Refused::sweep_running, "sweep " + std::to_string(sweep_->id()) + " is running"};
         if (enabled_ || stop_.active())
           return Refusal{Refused::bench_in_use, "the bench is enabled by hand; disable it first"};

@@ -130,6 +130,7 @@ class BenchRuntime {
   std::optional<Refusal> apply_setpoints();
   std::optional<Refusal> begin_disable(double now_s);
   std::optional<Refusal> busy_with_sweep() const;
+  std::optional<Refusal> tripped_refusal() const;  // while the supervisor's trip latches
   void finish_sweep(double now_s);
   bool settled() const;
   void final_disable(double now_s);

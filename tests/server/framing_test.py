@@ -168,9 +168,11 @@ def ws_burst(d, viewer):
     frames = [json.dumps({"op": "request", "id": i, "method": "GET", "path": "/api/openapi.json"}) for i in range(n)]
     sent = threading.Event()
 
+    # At once, as one write: the daemon finds thousands of whole messages in one read.
+    burst_bytes = b"".join(ws_util.websocket.ABNF.create_frame(f, ws_util.websocket.ABNF.OPCODE_TEXT).format() for f in frames)
+
     def burst():
-        for f in frames:
-            ws.send(f)
+        ws.sock.sendall(burst_bytes)
         sent.set()
 
     threading.Thread(target=burst, daemon=True).start()

@@ -175,7 +175,8 @@ try {
   check(spun, 'the bench spins up to 600 rpm from the live view');
   await page.waitForTimeout(1500);
   await shot(page, artifacts, '11-live-running');
-  await page.focus('#setpoints-form [name="speed_rpm"]'); // Esc works inside a field too
+  await page.focus('#setpoints-form [name="speed_rpm"]'); // inside a field: Esc twice
+  await page.keyboard.press('Escape');
   await page.keyboard.press('Escape');
   check(await until(async () => (await text(page, '#bench-pill')) === 'E-STOPPED', 5000), 'Esc: the bench pill shows E-STOPPED');
   const st = await rest(daemon.url, 'GET', '/api/bench/status', token);

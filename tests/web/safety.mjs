@@ -154,12 +154,23 @@ try {
   await page.click('#btn-enable');
   check(await until(async () => (await far.speedRpm()) > 100, 15000), `the drive turns (far side: ${(await far.speedRpm()).toFixed(0)} rpm)`);
   check(Math.abs((await far.speedSetpointRpm()) - 900) < 1, `far side: speed setpoint register ${await far.speedSetpointRpm()} rpm`);
-  // Esc with the focus in a form field: still the E-stop.
+  // Esc in an edit field undoes the edit, no E-stop; a second Esc within a second E-stops.
   await page.focus('#setpoints-form [name=speed_rpm]');
-  const answer = page.waitForResponse((r) => r.url().endsWith('/api/bench/estop') && r.request().method() === 'POST', { timeout: 5000 });
+  await page.fill('#setpoints-form [name=speed_rpm]', '1234');
+  let estops = 0;
+  page.on('request', (r) => { if (r.url().endsWith('/api/bench/estop')) estops++; });
   await page.keyboard.press('Escape');
+  await page.waitForTimeout(1300);
+  check((await page.inputValue('#setpoints-form [name=speed_rpm]')) === '900', `Esc in a field puts back its value (${await page.inputValue('#setpoints-form [name=speed_rpm]')})`);
+  check(estops === 0 && (await phase()) === 'normal' && (await far.states()).every(([s]) => s === 1),
+    `... and is no E-stop: phase ${await phase()}, far side both running (${describe(await far.states())})`);
+  await page.keyboard.press('Escape'); // more than a second later: undoes again, still no E-stop
+  await page.waitForTimeout(300);
+  check(estops === 0 && (await phase()) === 'normal', 'one Esc a second later in the field is again no E-stop');
+  const answer = page.waitForResponse((r) => r.url().endsWith('/api/bench/estop') && r.request().method() === 'POST', { timeout: 5000 });
+  await page.keyboard.press('Escape'); // the second within a second
   const st = await (await answer).json();
-  check(st.supervisor.phase === 'estopped', 'Esc in a form field E-stops');
+  check(st.supervisor.phase === 'estopped', 'Esc twice within a second in a form field E-stops');
   check(st.setpoints.speed_rpm === 0 && st.setpoints.load_Nm === 0 && st.setpoints.angle_deg === 55,
     `the E-stop's own answer shows the setpoints zeroed (${JSON.stringify(st.setpoints)})`);
   check(st.supervisor.disable.synrm.setpoint_zeroed && st.supervisor.disable.load.setpoint_zeroed,

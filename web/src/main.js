@@ -4,6 +4,7 @@
 import './style.css';
 import { api, setToken, setUnauthorizedHandler, ApiError } from './api.js';
 import { Link, faultText } from './link.js';
+import { renderTripControls } from './trip.js';
 import { LiveView } from './views/live.js';
 import { SweepView } from './views/sweep.js';
 import { ResultsView } from './views/results.js';
@@ -46,7 +47,8 @@ class App {
       if (r && r.t_s !== undefined && r.supervisor) this.setStatus(r);
       return r;
     } catch (e) {
-      this.toast(`${path.replace('/api/', '')}: ${e.message}${e.code ? ` (${e.code})` : ''}`, true);
+      // In an operator's words: the action, then the daemon's reason (never a route).
+      this.toast(`${actionName(method, path)}: ${e.message}`, true);
       throw e;
     }
   }
@@ -55,6 +57,7 @@ class App {
     this.status = st;
     this.emit('status', st);
     renderBenchPills(st);
+    renderTripControls(st, this.isOperator);
     // A failed E-stop's banner stays until the daemon itself says the bench is stopped.
     if (st.supervisor?.phase === 'estopped' && !st.enabled) $('#estop-failed').hidden = true;
   }
@@ -78,6 +81,19 @@ class App {
     await this.refreshSweeps();
     this.emit('refresh');
   }
+}
+
+// A command's name as the page's controls call it, for its error message.
+function actionName(method, path) {
+  const names = {
+    '/api/bench/enable': 'Enable / ordered stop', '/api/bench/setpoints': 'Apply setpoints', '/api/bench/reset': 'Reset trip',
+    '/api/bench/mode': 'Apply estimator and PWM', '/api/bench/lock': method === 'DELETE' ? 'Release lock' : 'Take control lock',
+    '/api/bench/estop': 'E-stop', '/api/sweeps': 'Create sweep',
+  };
+  if (names[path]) return names[path];
+  const m = /^\/api\/sweeps\/(\d+)\/(\w+)$/.exec(path);
+  if (m) return `Sweep #${m[1]}: ${m[2] === 'start' ? 'start / continue' : m[2]}`;
+  return 'The daemon refused';
 }
 
 export const app = new App();
@@ -152,7 +168,7 @@ function renderRole() {
   // Every signed-in role may E-stop (the daemon records who did); only operators command.
   for (const el of document.querySelectorAll('.estop')) {
     el.disabled = !app.role;
-    el.title = app.role ? 'Emergency stop: both drives disabled at once, latched until reset (key: Esc)' : 'E-stop needs a sign-in';
+    el.title = app.role ? 'Emergency stop: both drives disabled at once, latched until reset (key: Esc; in an edit field Esc twice)' : 'E-stop needs a sign-in';
   }
   app.emit('role', app.role);
 }
@@ -289,14 +305,35 @@ function openHelp() {
   if (!$('#help').open) $('#help').showModal();
 }
 
+// An edit field's value when it took the focus: what Esc in the field puts back.
+const isField = (t) => !!t && (t.isContentEditable || ['INPUT', 'SELECT', 'TEXTAREA'].includes(t.tagName))
+  && !['checkbox', 'radio', 'button', 'submit'].includes(t.type);
+document.addEventListener('focusin', (e) => { if (isField(e.target) && !e.target.isContentEditable) e.target.dataset.escValue = e.target.value; });
+// Within this of an Esc that restored a field, a second Esc is the E-stop.
+const ESC_TWICE_MS = 1000;
+let fieldEscAt = -Infinity;
+
 document.addEventListener('keydown', (e) => {
   if (e.key === 'Escape') {
-    // Esc is the E-stop everywhere, also in fields; in the help dialog it closes the dialog (what
-    // Esc does in every dialog; the dialog's own E-STOP button is there), and in the sign-in
-    // dialog it does nothing (no token to stop with yet).
+    // Esc is the E-stop; in an edit field the first Esc puts back the value the field had (what
+    // Esc does in every form) and a second within a second E-stops. In the help dialog it closes
+    // the dialog (what Esc does in every dialog; the dialog's own E-STOP button is there), and in
+    // the sign-in dialog it does nothing (no token to stop with yet).
     e.preventDefault();
     if ($('#signin').open) return;
     if ($('#help').open) { $('#help').close(); return; }
+    const t = e.target;
+    if (isField(t) && !t.isContentEditable && performance.now() - fieldEscAt > ESC_TWICE_MS) {
+      fieldEscAt = performance.now();
+      if (t.dataset.escValue !== undefined && t.value !== t.dataset.escValue) {
+        t.value = t.dataset.escValue;
+        t.dispatchEvent(new Event('input', { bubbles: true }));
+        t.dispatchEvent(new Event('change', { bubbles: true }));
+      }
+      app.toast('Edit undone. Esc again within a second: E-STOP');
+      return;
+    }
+    fieldEscAt = -Infinity;
     estop();
     return;
   }

@@ -3,6 +3,7 @@
 // status cells, keyboard-reachable; ETA; abort with a reason; efficiency map and trajectories
 // filling in as points complete).
 import { api, ApiError, getToken } from '../api.js';
+import { tripReason } from '../trip.js';
 import { ChartCard } from '../charts.js';
 import { ESTIMATORS, benchLimitErrors, describePlan, expandGroups, expandPlan, fmtDuration, values } from '../plan.js';
 import { effMapOption, trajectoriesOption, cfgLabel } from './plots.js';
@@ -59,6 +60,7 @@ export class SweepView {
     $('#p-abort').addEventListener('click', () => this.askAbort());
     this.abortDialog();
     $('#p-restart').addEventListener('click', () => this.action('start'));
+    $('#p-reset').addEventListener('click', () => app.command('POST', '/api/bench/reset', {}, 'Trip and faults reset').catch(() => {}));
 
     app.on('view', ({ view, arg }) => {
       this.visible = view === 'sweep';
@@ -394,6 +396,7 @@ export class SweepView {
   }
 
   onStatus(st) {
+    this.renderButtons(); // a trip latched or reset changes what may start
     const s = st.sweep;
     if (!s) return;
     // Follow the running sweep (started here, from another page or a CLI).
@@ -481,9 +484,14 @@ export class SweepView {
     $('#p-pause').disabled = !op || !c || st !== 'running';
     $('#p-resume').disabled = !op || !c || st !== 'paused';
     $('#p-abort').disabled = !op || !c || !ACTIVE.includes(st);
-    $('#p-restart').disabled = !op || !c || ACTIVE.includes(st) || st === 'completed';
+    // A latched trip: nothing starts the bench until Reset trip (trip.js says why, in words).
+    const tripped = tripReason(this.app.status);
+    $('#p-restart').disabled = !op || !c || ACTIVE.includes(st) || st === 'completed' || !!tripped;
+    $('#p-restart').title = tripped && c && !ACTIVE.includes(st) && st !== 'completed' ? tripped : '';
     const bad = !!this.planErrors?.length;
-    $('#b-start').disabled = !op || bad;
+    $('#b-start').disabled = !op || bad || !!tripped;
+    $('#b-start').title = tripped;
+    $('#p-reset').disabled = !op;
     $('#b-create').disabled = !op || bad;
   }
 
