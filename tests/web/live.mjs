@@ -82,12 +82,15 @@ try {
     check(feedRows.every((r) => byIndex.has(r.index) && Math.abs(Number(r.eta) - byIndex.get(r.index).efficiency) < 1e-9),
       `each feed row's η is its stored point's efficiency (${feedRows.map((r) => r.eta).join(', ')})`);
     check(feedRows[0].index > feedRows[1].index, 'the newest point is first');
-    check(/η 0\.\d+ ± [\d.]+, I_m [\d.]+ ± [\d.]+ A, P_dcM [\d.]+ ± [\d.]+ W, settle [\d.]+ s, (settled|unstable)/.test(feedRows[0].text), `a row reads "${feedRows[0].text}"`);
+    check(/η \d{1,2}(\.\d+)? ± [\d.]+ %, I_m [\d.]+ ± [\d.]+ A, P_dcM [\d.]+ ± [\d.]+ W, settle [\d.]+ s, (settled|unstable)/.test(feedRows[0].text), `a row reads "${feedRows[0].text}"`);
     // Each value's ± is its stored point's combined standard uncertainty (issue 26), in the order η, I_m, P_dcM.
     const us = await page.$$eval('#live-points li', (ls) => ls.map((l) => ({ index: Number(l.dataset.index), u: [...l.querySelectorAll('.u')].map((e) => Number(e.dataset.u)) })));
     check(us.length >= 2 && us.every((r) => { const p = byIndex.get(r.index); return p && r.u.length === 3 && p.efficiency_u > 0
-      && r.u[0] === p.efficiency_u && r.u[1] === p.im_u_A && r.u[2] === p.pdcm_u_W; }),
-      `each feed row's ± u are its stored point's efficiency_u, im_u_A, pdcm_u_W (${JSON.stringify(us[0]?.u)})`);
+      && Math.abs(r.u[0] - p.efficiency_u * 100) < 1e-12 && r.u[1] === p.im_u_A && r.u[2] === p.pdcm_u_W; }),
+      `each feed row's ± u are its stored point's efficiency_u (in %), im_u_A, pdcm_u_W (${JSON.stringify(us[0]?.u)})`);
+    // η in %, as everywhere on the page: the text's value is the stored fraction x 100.
+    const shown = Number(/η ([\d.]+) ±/.exec(feedRows[0].text)?.[1]);
+    check(Math.abs(shown - byIndex.get(feedRows[0].index).efficiency * 100) < 0.06, `the feed's η is in % (${shown} %)`);
   }
   await shot(page, artifacts, 'live-1-sweep');
 
@@ -96,9 +99,12 @@ try {
   check(es.status === 200, 'an E-stop over REST (the sweep faults)');
   check(await until(async () => (await readout(page, 'disable')).startsWith('both drives read back disabled'), 15000),
     `the readout shows the disable read back: "${await readout(page, 'disable')}"`);
-  check(await until(async () => !(await page.$eval('#btn-enable', (b) => b.disabled)), 10000), 'Enable is active again once no sweep runs');
+  // No sweep runs now, but the E-stop's trip latches: Enable waits for Reset trip, saying so.
+  check(await until(async () => page.$eval('#btn-enable', (b) => b.disabled && /tripped/.test(b.title)), 10000),
+    `Enable stays disabled while the trip latches, saying why ("${await page.$eval('#btn-enable', (b) => b.title)}")`);
   await shot(page, artifacts, 'live-2-estop');
   check(!!(await until(async () => (await rest(daemon.url, 'POST', '/api/bench/reset', token, {})).status === 200, 15000)), 'reset after the E-stop');
+  check(await until(async () => !(await page.$eval('#btn-enable', (b) => b.disabled)), 10000), 'Enable is active again once no sweep runs and the trip is reset');
 
   // ---- 2. the scope ---------------------------------------------------------------------------
   await page.selectOption('#scope-span', '10');

@@ -53,6 +53,8 @@ try {
   await page.goto(`${origin.url}#/results/1`);
   await page.waitForSelector('#signin[open]', { timeout: 15000 });
   await page.waitForTimeout(500);
+  const pillBefore = await page.$eval('#fault-pill', (e) => ({ state: e.dataset.state, text: e.textContent }));
+  check(pillBefore.state === 'unknown' && pillBefore.text === 'faults ?', `before a sign-in the fault pill is unknown, not "no fault" (${JSON.stringify(pillBefore)})`);
   const before = first.filter((r) => r.path !== '/api/health');
   check(before.length === 0, `before a sign-in the page asks nothing but /api/health (${JSON.stringify(before)})`);
   await page.fill('#signin-token', token);

@@ -8,6 +8,8 @@ import { fmtU, known } from '../errorbars.js';
 import { sig } from '../scope.js';
 
 const ACTIVE = ['running', 'pausing', 'paused', 'stopping'];
+// Efficiency in % everywhere on the page (a fraction in the record, docs/record.md).
+const pct = (v) => (v == null || !Number.isFinite(v) ? v : v * 100);
 const FEED_N = 10;
 const $ = (s) => document.querySelector(s);
 // The manual controls a sweep's bench refuses (the daemon answers sweep_running).
@@ -80,7 +82,7 @@ export class SweepFeed {
       const gate = p.fault ? `fault ${p.fault}` : p.unstable ? 'unstable' : 'settled';
       return `<li data-eta="${p.efficiency ?? ''}" data-index="${p.point_index}"><b>#${p.point_index + 1}</b> `
         + `${sig(p.speed_rpm)} rpm ${sig(p.load_Nm)} N m ${sig(p.angle_deg)}°: `
-        + `η ${withU(p.efficiency, 3, p.efficiency_u, p.efficiency_u_repeat, '')}, `
+        + `η ${withU(pct(p.efficiency), 3, pct(p.efficiency_u), pct(p.efficiency_u_repeat), ' %')}, `
         + `I_m ${withU(p.im_A, 3, p.im_u_A, p.im_u_repeat_A, ' A')}, P_dcM ${withU(p.pdcm_W, 4, p.pdcm_u_W, p.pdcm_u_repeat_W, ' W')}, `
         + `settle ${sig(p.settle_s, 3)} s, <span class="gate ${p.unstable || p.fault ? 'bad' : 'ok'}">${gate}</span></li>`;
     }).join('');
