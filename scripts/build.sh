@@ -12,13 +12,9 @@ targets=()
 for t in "$@"; do targets+=(--target "$t"); done
 
 if command -v npm >/dev/null 2>&1; then
+  scripts/npm-ci.sh web
   (
     cd web
-    stamp=node_modules/.synbench-lock
-    if [ ! -f "$stamp" ] || ! cmp -s package-lock.json "$stamp"; then
-      npm ci --no-audit --no-fund --loglevel=error
-      cp package-lock.json "$stamp"
-    fi
     if [ ! -f dist/index.html ] || [ -n "$(find index.html vite.config.js package-lock.json src -newer dist/index.html 2>/dev/null | head -1)" ]; then
       npm run --silent build -- --logLevel warn
     fi

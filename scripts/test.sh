@@ -7,6 +7,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
+# The API tools the tests run on the OpenAPI document (Redocly CLI, a generated client).
+if command -v npm >/dev/null 2>&1; then scripts/npm-ci.sh tests/api-tools; fi
 scripts/build.sh default
 ctest --preset default -j"$(nproc)" "$@"
 if [ "${SYNBENCH_TEST_SANITIZERS:-1}" != 0 ]; then

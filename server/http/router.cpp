@@ -2,6 +2,7 @@
 #include "server/http/router.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <atomic>
 #include <exception>
 #include <future>
@@ -10,6 +11,7 @@
 #include <set>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include "drivers/json_file.hpp"
 #include "drivers/utf8.hpp"
@@ -276,12 +278,41 @@ void Router::route_and_call(const std::string& method, const std::string& target
   reply(route->handler(req));
 }
 
+// A client generator's method name: the method, then the path's words in camel case, "api"
+// left out; a path parameter makes the word before it singular ("getSweepPoints" for GET
+// /api/sweeps/{id}/points, "getBenchStatus", "getOpenapiJson"). URL-safe and unique per route.
+std::string operation_id(const std::string& method, const std::string& pattern) {
+  std::string id = ascii_lower(method);
+  std::vector<std::string> words;
+  for (const auto seg : segments(pattern)) {
+    if (seg.size() > 2 && seg.front() == '{') {
+      if (!words.empty() && words.back().size() > 3 && words.back().back() == 's') words.back().pop_back();
+      continue;
+    }
+    if (words.empty() && seg == "api") continue;
+    std::string word;
+    bool upper = true;
+    for (const char ch : seg) {
+      if (ch == '-' || ch == '_' || ch == '.') {
+        upper = true;
+        continue;
+      }
+      const auto c = static_cast<unsigned char>(ch);
+      word += static_cast<char>(upper ? std::toupper(c) : std::tolower(c));
+      upper = false;
+    }
+    words.push_back(word);
+  }
+  for (const auto& w : words) id += w;
+  return id;
+}
+
 synbench::Json Router::openapi(const std::string& title, const std::string& version) const {
   synbench::Json paths = synbench::Json::object();
   for (const Route& r : routes_) {
     synbench::Json op;
     op["summary"] = r.summary;
-    op["operationId"] = ascii_lower(r.method) + r.pattern;
+    op["operationId"] = operation_id(r.method, r.pattern);
     op["x-synbench-role"] = role_name(r.role);
     if (r.role != Role::anyone) op["security"] = synbench::Json::array({{{"bearer", synbench::Json::array()}}});
     else op["security"] = synbench::Json::array();
@@ -298,16 +329,25 @@ synbench::Json Router::openapi(const std::string& title, const std::string& vers
     synbench::Json responses = {{"200", ok},
                                 {"default", {{"description", "error"},
                                              {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}}};
+    // Every route can be refused: a Host header that does not name the daemon (403), a request
+    // that is not well-formed HTTP (400); a route with a role, a missing or invalid token (401).
+    responses["400"] = {{"description", "a malformed request or body, the field named in the error"}};
     if (r.role != Role::anyone) {
       responses["401"] = {{"description", "no or invalid bearer token"}};
-      responses["403"] = {{"description", std::string("the token's role is below ") + role_name(r.role)}};
+      responses["403"] = {{"description", std::string("the token's role is below ") + role_name(r.role) +
+                                              ", or the Host header does not name the daemon"}};
+    } else {
+      responses["403"] = {{"description", "the Host header does not name the daemon"}};
     }
     op["responses"] = responses;
     paths[r.pattern][ascii_lower(r.method)] = op;
   }
   return {
       {"openapi", "3.0.3"},
-      {"info", {{"title", title}, {"version", version}}},
+      {"info", {{"title", title}, {"version", version},
+                {"description", "The REST API of the synbench daemon (docs/api.md): the bench, its sweeps and their results."}}},
+      // Relative: the daemon that served the document (behind a proxy, under its address).
+      {"servers", synbench::Json::array({{{"url", "/"}, {"description", "the daemon that served this document"}}})},
       {"paths", paths},
       {"components",
        {{"securitySchemes", {{"bearer", {{"type", "http"}, {"scheme", "bearer"}}}}},

@@ -134,5 +134,8 @@ std::optional<Response> check_body(const synbench::Json& schema, const std::stri
 std::map<std::string, std::string> parse_query(std::string_view query);
 // True when `path` matches `pattern`; fills `params` with the {name} segments.
 bool match_pattern(std::string_view pattern, std::string_view path, std::map<std::string, std::string>& params);
+// The OpenAPI operationId of a route: "getBenchStatus" for GET /api/bench/status,
+// "getSweepPoints" for GET /api/sweeps/{id}/points.
+std::string operation_id(const std::string& method, const std::string& pattern);
 
 }  // namespace synbench::http

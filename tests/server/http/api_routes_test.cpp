@@ -16,6 +16,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <set>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -166,6 +167,21 @@ TEST(StatusJson, AnUnreadDriveSaysWhy) {
   EXPECT_TRUE(j["load_error"].is_null());
   const auto errors = validate(status_schema(), j);
   EXPECT_TRUE(errors.empty()) << to_string(errors);
+}
+
+// Every operation of the daemon's document has an operationId of its own (a generated client's
+// method names; tests/api-tools/openapi_test.mjs calls them).
+TEST_F(Api, OperationIdsAreUnique) {
+  const auto doc = synbench::Json::parse(router.dispatch("GET", "/api/openapi.json", "", "").body);
+  std::set<std::string> ids;
+  std::size_t ops = 0;
+  for (const auto& [path, methods] : doc["paths"].items())
+    for (const auto& [method, op] : methods.items()) {
+      ++ops;
+      EXPECT_TRUE(ids.insert(op["operationId"].get<std::string>()).second) << op["operationId"] << " twice";
+    }
+  EXPECT_EQ(ids.size(), ops);
+  EXPECT_TRUE(ids.count("getBenchStatus") && ids.count("postBenchEstop") && ids.count("deleteBenchLock"));
 }
 
 TEST_F(Api, TwinFollowsSpeedSetpointAndEstopLatches) {

@@ -184,6 +184,20 @@ TEST(Router, OpenApiListsEveryRouteWithRoleAndPathParameters) {
   EXPECT_EQ(start["parameters"][0]["name"], "id");
   EXPECT_TRUE(start["responses"].contains("401"));
   EXPECT_TRUE(doc["paths"]["/api/open"]["get"]["security"].empty());
+  // Readable, URL-safe operationIds a client generator turns into method names.
+  EXPECT_EQ(start["operationId"], "postThingStart");
+  EXPECT_EQ(operation_id("GET", "/api/bench/status"), "getBenchStatus");
+  EXPECT_EQ(operation_id("GET", "/api/sweeps/{id}/points"), "getSweepPoints");
+  EXPECT_EQ(operation_id("GET", "/api/sweeps/{id}/report.csv"), "getSweepReportCsv");
+  EXPECT_EQ(operation_id("DELETE", "/api/bench/lock"), "deleteBenchLock");
+  EXPECT_EQ(operation_id("GET", "/metrics"), "getMetrics");
+  EXPECT_EQ(doc["servers"][0]["url"], "/");
+  for (const auto& [path, methods] : doc["paths"].items())
+    for (const auto& [method, op] : methods.items()) {
+      EXPECT_TRUE(op["responses"].contains("400") && op["responses"].contains("403")) << method << " " << path;
+      const std::string id = op["operationId"];
+      EXPECT_EQ(id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"), std::string::npos) << id;
+    }
   // The published request schema is the one the router checks.
   EXPECT_EQ(doc["paths"]["/api/things"]["post"]["requestBody"]["content"]["application/json"]["schema"],
             r.routes()[6].request_schema.value());
