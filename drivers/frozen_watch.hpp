@@ -21,7 +21,9 @@ namespace synbench::drivers {
 // floor still changes between reads (a step of a third of sigma leaves a run of 20 equal reads
 // no chance). Measured on the twin (tests/emulator/telemetry_noise_test.cpp, read every 50 ms
 // for 5 s at 300 rpm unloaded, 1000 rpm 2 N m, 1500 rpm 3.5 N m; the quietest point quoted):
-// speed_rpm 0.052 rpm, im_A 0.54 mA, id_A 0.30 mA, iq_A 0.43 mA, ud_V 0.013 V, uq_V 0.019 V.
+// speed_rpm 0.081 rpm, im_A 0.56 mA, id_A 0.30 mA, iq_A 0.43 mA, ud_V 0.016 V, uq_V 0.015 V
+// (uq_V at 1500 rpm 3.5 N m, on the voltage limit, where the speed loop no longer integrates:
+// 0.019 V before it stopped winding up, issue 37).
 // The currents agree with physics.md: sigma_i = 15.8 mA per 100 us ADC sample through the
 // firmware's 50 ms telemetry filter is 15.8 mA x sqrt(1e-4 / (2 x 0.05)) = 0.5 mA. So 1 mA
 // steps are not watched (as i16 at 0.001 A, a steady current froze 1 run in 25), 0.01 A
@@ -32,7 +34,7 @@ struct TelemetryNoise {
   double speed_rpm, im_A, id_A, iq_A, ud_V, uq_V;
 };
 inline constexpr TelemetryNoise kRunningNoise{
-    .speed_rpm = 0.015, .im_A = 1.5e-4, .id_A = 1e-4, .iq_A = 1.4e-4, .ud_V = 0.004, .uq_V = 0.006};
+    .speed_rpm = 0.015, .im_A = 1.5e-4, .id_A = 1e-4, .iq_A = 1.4e-4, .ud_V = 0.004, .uq_V = 0.005};
 
 // One watched value: its name and unit, where its step, floor and value live.
 struct WatchedSignal {

@@ -62,8 +62,16 @@ void ConnectionRegistry::evict(std::map<std::uint64_t, Entry>::iterator it) {
   if (close) close();
 }
 
-bool ConnectionRegistry::make_room(const std::string& client, std::size_t max, std::size_t max_per_client) {
+bool ConnectionRegistry::make_room(const std::string& client, std::size_t max, std::size_t max_per_client,
+                                   std::size_t max_untrusted) {
   std::lock_guard lock(mutex_);
+  const auto untrusted = [&] {
+    std::size_t n = 0;
+    for (const auto& [id, e] : entries_) n += e.trust == Trust::none;
+    return n;
+  };
+  // The lowest trust goes first: while any connection is untrusted, the victim is one of them.
+  while (untrusted() >= max_untrusted) evict(victim(nullptr));
   const auto mine = [&] {
     std::size_t n = 0;
     for (const auto& [id, e] : entries_) n += e.client == client;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -37,11 +38,13 @@ class ConnectionRegistry {
   std::size_t count(const std::string& client) const;
   std::uint64_t evicted() const;
 
-  // Makes room for one more connection from `client` within `max` in all and `max_per_client`
-  // for it: closes (and forgets) as many of the oldest, least trusted connections below an
-  // operator's as needed, the client's own first when its share is the limit. False when only
-  // operators hold what would have to go: the new connection must be refused.
-  bool make_room(const std::string& client, std::size_t max, std::size_t max_per_client);
+  // Makes room for one more connection from `client` within `max` in all, `max_per_client` for
+  // it and `max_untrusted` of connections that never showed a valid token (the newcomer is one):
+  // closes (and forgets) as many of the oldest, least trusted connections below an operator's
+  // as needed, the client's own first when its share is the limit. False when only operators
+  // hold what would have to go: the new connection must be refused.
+  bool make_room(const std::string& client, std::size_t max, std::size_t max_per_client,
+                 std::size_t max_untrusted = SIZE_MAX);
 
  private:
   struct Entry {

@@ -373,6 +373,8 @@ class HttpServer::Listener : public std::enable_shared_from_this<HttpServer::Lis
     if (!ec) acceptor_.set_option(net::socket_base::reuse_address(true), ec);
     if (!ec) acceptor_.bind(ep, ec);
     if (!ec) acceptor_.listen(net::socket_base::max_listen_connections, ec);
+    // Non-blocking, so that on_accept can take what else is pending without waiting.
+    if (!ec) acceptor_.non_blocking(true, ec);
     return ec;
   }
   std::uint16_t port() const { return acceptor_.local_endpoint().port(); }
@@ -393,17 +395,34 @@ class HttpServer::Listener : public std::enable_shared_from_this<HttpServer::Lis
       if (ec == net::error::operation_aborted) return;
       fail(ec, "accept");
     } else {
-      beast::error_code ep;
-      const auto remote = socket.remote_endpoint(ep);
-      const std::string client = ep ? std::string("?") : remote.address().to_string();
-      const bool room = shared_->registry->make_room(client, shared_->limits.max_connections,
-                                                     shared_->limits.max_connections_per_client);
-      auto session = std::make_shared<Session>(std::move(socket), shared_);
-      if (room) session->run(client);
-      else session->refuse();
+      admit(std::move(socket));
+      // Under a flood of connections the backlog is long: taken one per handler, every open
+      // connection's work runs between two accepts, and a newcomer (an operator's E-stop) waits
+      // behind all of them. What else is pending is taken now, up to kAcceptBurst.
+      for (int i = 0; i < kAcceptBurst && acceptor_.is_open(); ++i) {
+        beast::error_code more;
+        tcp::socket next(net::make_strand(io_));
+        acceptor_.accept(next, more);  // would_block once none is pending
+        if (more) break;
+        admit(std::move(next));
+      }
     }
     if (acceptor_.is_open()) do_accept();
   }
+
+  void admit(tcp::socket socket) {
+    beast::error_code ep;
+    const auto remote = socket.remote_endpoint(ep);
+    const std::string client = ep ? std::string("?") : remote.address().to_string();
+    const bool room = shared_->registry->make_room(client, shared_->limits.max_connections,
+                                                   shared_->limits.max_connections_per_client,
+                                                   shared_->limits.max_untrusted_connections);
+    auto session = std::make_shared<Session>(std::move(socket), shared_);
+    if (room) session->run(client);
+    else session->refuse();
+  }
+
+  static constexpr int kAcceptBurst = 32;
 
   net::io_context& io_;
   tcp::acceptor acceptor_;

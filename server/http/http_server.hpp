@@ -37,6 +37,10 @@ struct ServerLimits {
   // address: 64 connections from one client fit without an eviction.
   std::size_t max_connections = 256;
   std::size_t max_connections_per_client = 192;  // one client address's share
+  // Connections that have not shown a valid token (each new one among them): a flood of them
+  // churns within this many, as the whole house did when it held 64, and costs an operator's
+  // new connection no more wait in the accept queue than it did then.
+  std::size_t max_untrusted_connections = 64;
 };
 
 // Host header values accepted for a server listening on host:port: "host:port", and for a

@@ -5,7 +5,7 @@ opens a fresh connection and sends POST /api/bench/estop (then a reset) 20 times
 must answer 200 within 100 ms, the daemon must stay up, and the bench must read estopped.
 
   slowloris  180 connections held open by a reconnecting attacker, each trickling one byte of a
-             request header every 0.5 s and never finishing it (the connection cap is 64)
+             request header every 0.5 s and never finishing it (64 untrusted connections at most)
   ws-idle    60 WebSocket upgrades that never authenticate, reopened as soon as they close
   flood      wrk -t2 -c300 on GET /api/health (skipped without wrk)
   estimate   8 viewers and 2 operators looping POST /api/sweeps/estimate on a 10^6-point plan

@@ -37,6 +37,22 @@ TEST(ConnectionRegistry, AFullHouseClosesTheOldestOfTheLeastTrusted) {
   EXPECT_EQ(h.reg.size(), 1u);
 }
 
+// Connections that never showed a token have a share of their own: at it, the oldest of them
+// goes, even with room in the house; trusted connections are not counted and never go for it.
+TEST(ConnectionRegistry, UntrustedConnectionsHaveAShareOfTheirOwn) {
+  House h;
+  h.add("viewer", "10.0.0.2", Trust::viewer);
+  h.add("anon-old", "10.0.0.3");
+  h.add("anon-new", "10.0.0.4");
+  EXPECT_TRUE(h.reg.make_room("10.0.0.9", 100, 100, 3));
+  EXPECT_TRUE(h.closed.empty()) << "2 untrusted, the newcomer the 3rd";
+  EXPECT_TRUE(h.reg.make_room("10.0.0.9", 100, 100, 2));
+  EXPECT_EQ(h.closed, std::vector<std::string>{"anon-old"});
+  EXPECT_TRUE(h.reg.make_room("10.0.0.9", 100, 100, 1));
+  EXPECT_EQ(h.closed, (std::vector<std::string>{"anon-old", "anon-new"}));
+  EXPECT_EQ(h.reg.size(), 1u) << "the viewer stays";
+}
+
 TEST(ConnectionRegistry, AClientAtItsShareGivesUpItsOwnFirst) {
   House h;
   h.add("other-anon", "10.0.0.7");

@@ -78,7 +78,7 @@ TEST_F(SweepRoutes, PlanBodiesAreRefusedAtTheirPointer) {
     auto r = call("POST", route, R"({"mode": "random", "window_s": 0, "notes": [1], "preset": 3})");
     EXPECT_EQ(r.status, 400) << route;
     EXPECT_EQ(error_text(r),
-              "bad_plan /mode: must be one of grid, adaptive (got 'random'); /window_s: 0 is outside (0, 3600]; "
+              "bad_plan /mode: must be one of grid, adaptive (got 'random'); /window_s: 0 is outside [0.1, 3600]; "
               "/notes/0: must be a string; /preset: must be a string or an object")
         << route;
     r = call("POST", route, "[]");
