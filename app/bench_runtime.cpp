@@ -512,7 +512,8 @@ void BenchRuntime::final_disable(double now_s) {
   // The supervisor disables both (its events say which failed), reads them back and confirms
   // both stopped, or raises its alarm.
   supervisor_->expect_stopped(now_s);
-  const double deadline_s = now_s + description_.limits.stop_confirm_s + 0.05;
+  // As long as the supervisor's alarm may wait: the read-back plus each drive's own stop time.
+  const double deadline_s = supervisor_->stop_deadline_s().value_or(now_s) + 0.05;
   double t = now_s;
   while (supervisor_->confirming_stop() && !supervisor_->alarm() && t < deadline_s) {
     t += kTick.count() / 1000.0;

@@ -41,6 +41,7 @@ class CommandedDevices {
     std::error_code read_window(drivers::SynrmWindow& out) override { return d_->read_window(out); }
     std::string error_detail() const override { return d_->error_detail(); }
     drivers::TelemetryResolution resolution() const override { return d_->resolution(); }
+    double stop_time_s() const override { return d_->stop_time_s(); }
 
    private:
     drivers::SynrmDrive* d_;
@@ -56,6 +57,7 @@ class CommandedDevices {
     std::error_code read(drivers::LoadTelemetry& out) override { return d_->read(out); }
     std::error_code read_window(drivers::LoadWindow& out) override { return d_->read_window(out); }
     std::string error_detail() const override { return d_->error_detail(); }
+    double stop_time_s() const override { return d_->stop_time_s(); }
 
    private:
     drivers::LoadDrive* d_;

@@ -49,9 +49,11 @@ std::string failure(std::error_code ec, const std::string& detail) {
 
 // One disable request to one drive, its answer kept.
 template <class Drive>
-void send_disable(Drive& drive, DriveDisable& d) {
+void send_disable(Drive& drive, DriveDisable& d, double now_s) {
   const std::error_code ec = drive.disable_once();
   ++d.attempts;
+  d.last_sent_s = now_s;
+  d.last_acknowledged = !ec;
   if (ec) {
     d.state = DisableState::repeating;
     d.error = "disable not acknowledged: " + failure(ec, drive.error_detail());
@@ -67,8 +69,11 @@ void SafetySupervisor::disable_all(double now_s) {
   // being sent, nor its repeats inside one call delay it. The repeats come every tick.
   report_ = DisableReport{};
   report_->at_s = now_s;
-  send_disable(*dev_.synrm, report_->synrm);
-  send_disable(*dev_.load, report_->load);
+  send_disable(*dev_.synrm, report_->synrm, now_s);
+  send_disable(*dev_.load, report_->load, now_s);
+  // Each drive is given its documented stop time (an SS1-style ramp) on top of the read-back's.
+  report_->synrm.deadline_s = now_s + lim_.stop_confirm_s + dev_.synrm->stop_time_s();
+  report_->load.deadline_s = now_s + lim_.stop_confirm_s + dev_.load->stop_time_s();
   report_->synrm.first_acknowledged = report_->synrm.state == DisableState::acknowledged;
   report_->load.first_acknowledged = report_->load.state == DisableState::acknowledged;
   const auto tell = [this](const char* which, const DriveDisable& d) {
@@ -80,13 +85,18 @@ void SafetySupervisor::disable_all(double now_s) {
   tell("load", report_->load);
   // Right behind an acknowledged disable: an E-stop's own answer already says whether it took.
   zero_setpoints();
-  if (!confirm_deadline_s_) confirm_deadline_s_ = now_s + lim_.stop_confirm_s;
+  confirming_ = true;
 }
 
-void SafetySupervisor::repeat_disables() {
-  if (!confirm_deadline_s_ || !report_) return;
-  if (report_->synrm.state == DisableState::repeating) send_disable(*dev_.synrm, report_->synrm);
-  if (report_->load.state == DisableState::repeating) send_disable(*dev_.load, report_->load);
+void SafetySupervisor::repeat_disables(double now_s) {
+  if (!confirming_ || !report_) return;
+  // A lost request goes out again every tick; one the drive acknowledged (it still reads running,
+  // or cannot be read) at a bounded rate: repeating it every tick only loads the line.
+  const auto due = [now_s](const DriveDisable& d) {
+    return d.state == DisableState::repeating && (!d.last_acknowledged || now_s - d.last_sent_s >= kDisableRepeat_s - 1e-9);
+  };
+  if (due(report_->synrm)) send_disable(*dev_.synrm, report_->synrm, now_s);
+  if (due(report_->load)) send_disable(*dev_.load, report_->load, now_s);
 }
 
 void SafetySupervisor::zero_setpoints() {
@@ -110,19 +120,36 @@ void SafetySupervisor::estop(double now_s, const std::string& why) {
 
 void SafetySupervisor::expect_stopped(double now_s) { disable_all(now_s); }
 
+namespace {
+
+// "the SynRM drive still reports running" / "... cannot be read"; empty when it reads stopped.
+template <class Telemetry>
+std::string not_stopped(const char* which, const std::optional<Telemetry>& t) {
+  if (!t) return std::string("the ") + which + " drive cannot be read";
+  if (drivers::running(t->state))
+    return std::string("the ") + which + " drive still reports " + drivers::state_name(t->state);
+  return {};
+}
+
+}  // namespace
+
 std::string SafetySupervisor::unconfirmed() const {
   std::string s;
-  const auto add = [&s](const char* what) { s += (s.empty() ? "" : " and ") + std::string(what); };
-  if (!synrm_) add("the SynRM drive cannot be read");
-  else if (drivers::running(synrm_->state)) add("the SynRM drive still reports running");
-  if (!load_) add("the load drive cannot be read");
-  else if (drivers::running(load_->state)) add("the load drive still reports running");
+  for (const std::string& what : {not_stopped("SynRM", synrm_), not_stopped("load", load_)})
+    if (!what.empty()) s += (s.empty() ? "" : " and ") + what;
   return s;
 }
 
+std::optional<double> SafetySupervisor::stop_deadline_s() const {
+  if (!confirming_ || !report_) return std::nullopt;
+  return std::max(report_->synrm.deadline_s, report_->load.deadline_s);
+}
+
 void SafetySupervisor::confirm_stop(double now_s) {
-  if (!confirm_deadline_s_) return;
-  const auto check = [&](const char* which, DriveDisable& d, bool read, bool runs, const std::string& read_error) {
+  if (!confirming_) return;
+  const auto check = [&](const char* which, DriveDisable& d, bool read, std::optional<drivers::DriveState> state,
+                         double stop_time_s, const std::string& read_error) {
+    const bool runs = state && drivers::running(*state);
     if (read && !runs) {
       if (d.state == DisableState::confirmed) return;
       if (sink_ && (!d.first_acknowledged || d.attempts > 1))
@@ -133,36 +160,54 @@ void SafetySupervisor::confirm_stop(double now_s) {
       d.error.clear();
       return;
     }
+    // An acknowledged disable of a drive that ramps down on it (it reads stopping, or its
+    // profile documents a stop time): its ramp is progress until its deadline; not repeated.
+    if (read && d.last_acknowledged && now_s < d.deadline_s &&
+        (*state == drivers::DriveState::stopping || stop_time_s > 0.0)) {
+      d.state = DisableState::stopping;
+      d.error = drivers::printf_text("reports %s within its stop time (%.2f s)", drivers::state_name(*state),
+                                     d.deadline_s - report_->at_s);
+      return;
+    }
     // A disable lost on the link, or a drive that ignored it: repeated at the next tick's start,
     // also to a drive that cannot be read (a disable is harmless to repeat, and a flaky line may
     // carry it).
     d.state = DisableState::repeating;
-    d.error = read ? "still reports running" : "cannot be read back: " + read_error;
+    d.error = read ? std::string("still reports ") + drivers::state_name(*state) : "cannot be read back: " + read_error;
   };
   if (report_) {
-    check("SynRM", report_->synrm, synrm_.has_value(), synrm_ && drivers::running(synrm_->state), synrm_read_error_);
-    check("load", report_->load, load_.has_value(), load_ && drivers::running(load_->state), load_read_error_);
+    const auto state = [](const auto& t) { return t ? std::optional(t->state) : std::nullopt; };
+    check("SynRM", report_->synrm, synrm_.has_value(), state(synrm_), dev_.synrm->stop_time_s(), synrm_read_error_);
+    check("load", report_->load, load_.has_value(), state(load_), dev_.load->stop_time_s(), load_read_error_);
     zero_setpoints();
   }
-  const std::string running = unconfirmed();
-  if (running.empty()) {
+  if (unconfirmed().empty()) {
     // Tried no longer than the stop is confirmed: once it is, the bench may be enabled again
     // with setpoints of its own.
     if (sink_ && report_ && !(report_->synrm.setpoint_zeroed && report_->load.setpoint_zeroed))
       sink_("fault", "the setpoints could not be written to zero after the disable (the drives read back disabled)");
-    confirm_deadline_s_.reset();
+    confirming_ = false;
     return;
   }
-  if (alarm_ || now_s < *confirm_deadline_s_) return;
-  char when[48];
-  std::snprintf(when, sizeof when, " %.2f s after the disable", now_s - (*confirm_deadline_s_ - lim_.stop_confirm_s));
-  alarm_ = SafetyAlarm{running + when, now_s};
+  if (alarm_ || !report_) return;
+  // Only a drive past its own deadline raises the alarm; one still inside its stop time is named
+  // with it when both are late.
+  std::string late;
+  const auto add_late = [&](const DriveDisable& d, const std::string& what, double stop_time_s) {
+    if (what.empty() || now_s < d.deadline_s) return;
+    late += (late.empty() ? "" : " and ") + what;
+    if (stop_time_s > 0.0) late += drivers::printf_text(" (its stop time %.2f s)", stop_time_s);
+  };
+  add_late(report_->synrm, not_stopped("SynRM", synrm_), dev_.synrm->stop_time_s());
+  add_late(report_->load, not_stopped("load", load_), dev_.load->stop_time_s());
+  if (late.empty()) return;
+  alarm_ = SafetyAlarm{late + drivers::printf_text(" %.2f s after the disable", now_s - report_->at_s), now_s};
   if (sink_) sink_("alarm", "ALARM: " + alarm_->detail + "; their own watchdogs are the second line");
 }
 
 std::error_code SafetySupervisor::reset() {
   if (stop_.active()) return make_error_code(errc::busy);
-  if (alarm_ || confirm_deadline_s_) {
+  if (alarm_ || confirming_) {
     // A reset must never hide a drive that did not stop.
     if (!unconfirmed().empty()) return make_error_code(errc::busy);
   }
@@ -172,7 +217,7 @@ std::error_code SafetySupervisor::reset() {
   if (alarm_ && sink_) sink_("state", "alarm cleared: both drives read back stopped");
   trip_.reset();
   alarm_.reset();
-  confirm_deadline_s_.reset();
+  confirming_ = false;
   report_.reset();
   stop_duration_s_.reset();
   plausibility_.reset();
@@ -181,7 +226,7 @@ std::error_code SafetySupervisor::reset() {
 }
 
 void SafetySupervisor::tick(double now_s) {
-  repeat_disables();
+  repeat_disables(now_s);
   drivers::SynrmTelemetry st;
   drivers::LoadTelemetry lt;
   const std::error_code ec_s = dev_.synrm->read(st);

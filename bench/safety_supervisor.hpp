@@ -4,9 +4,12 @@
 // explicit reset; an E-stop disables both drives at once. Every stop ends in the supervisor's own
 // disable of both drives (each tried once before either is tried again), whose result is kept
 // drive by drive (disable_report.hpp) and checked by reading the drives back: a drive whose
-// disable was not acknowledged, or that still reads running or cannot be read, has its disable
-// repeated at the start of every tick, before the tick's reads (on a starved line the reads may
-// all time out first); after `stop_confirm_s` it latches a loud alarm. Once a drive's disable
+// disable was not acknowledged has it repeated at the start of every tick, before the tick's
+// reads (on a starved line the reads may all time out first); one that acknowledged it but still
+// reads running or cannot be read, at most every kDisableRepeat_s. A drive with a documented stop
+// time (SynrmDrive::stop_time_s, a profile's stop_time_ms: an SS1-style ramp on the run bit), or
+// that reads stopping, is ramping down: not repeated, and the loud alarm latches only when a
+// drive still runs `stop_confirm_s` plus its stop time after the disable. Once a drive's disable
 // went through, its setpoint (speed, load torque) is written to zero. Pure logic on the time it
 // is given.
 #pragma once
@@ -96,7 +99,11 @@ class SafetySupervisor {
   const std::optional<SafetyTrip>& trip() const { return trip_; }
   const std::optional<SafetyAlarm>& alarm() const { return alarm_; }
   // Set while a stop's disable is being confirmed by reading the drives back.
-  bool confirming_stop() const { return confirm_deadline_s_.has_value(); }
+  bool confirming_stop() const { return confirming_; }
+  // When the alarm is due if a drive still does not read back stopped: the later of the two
+  // drives' (the disable + stop_confirm_s + the drive's documented stop time); empty when not
+  // confirming.
+  std::optional<double> stop_deadline_s() const;
   // Which drives the last read found running or could not read, in words ("the SynRM drive
   // still reports running"); empty when both read back off.
   std::string unconfirmed() const;
@@ -111,7 +118,7 @@ class SafetySupervisor {
              std::optional<std::int64_t> fault_code_raw = std::nullopt);
   void advance_stop(double now_s);
   void disable_all(double now_s);
-  void repeat_disables();
+  void repeat_disables(double now_s);
   void confirm_stop(double now_s);
   void zero_setpoints();
 
@@ -126,7 +133,7 @@ class SafetySupervisor {
   OrderedStop stop_;
   std::optional<SafetyTrip> trip_;
   std::optional<SafetyAlarm> alarm_;
-  std::optional<double> confirm_deadline_s_;
+  bool confirming_ = false;  // a stop's disable is being confirmed by reading the drives back
   std::optional<DisableReport> report_;
   std::string synrm_read_error_, load_read_error_;  // of this tick's reads
   std::optional<double> stop_duration_s_;

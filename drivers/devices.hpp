@@ -128,6 +128,10 @@ class SynrmDrive {
   virtual std::string error_detail() const { return {}; }
   // The steps of the telemetry read() returns; the default: continuous (a twin, a float map).
   virtual TelemetryResolution resolution() const { return {}; }
+  // The drive's documented stop time: how long after an acknowledged disable it may still read
+  // running or stopping (an SS1-style drive ramps down on its run bit); 0: at once (gates off).
+  // The safety supervisor alarms only past it (bench/safety_supervisor.hpp).
+  virtual double stop_time_s() const { return 0.0; }
 };
 
 struct LoadTelemetry {
@@ -158,6 +162,7 @@ class LoadDrive {
   virtual std::error_code read(LoadTelemetry& out) = 0;
   virtual std::error_code read_window(LoadWindow& out) = 0;
   virtual std::string error_detail() const { return {}; }  // as SynrmDrive's
+  virtual double stop_time_s() const { return 0.0; }         // as SynrmDrive's
 };
 
 // VFC counts of the two DC-bus currents over the gate, and the currents the meter derives; or

@@ -42,6 +42,7 @@ class SynrmAdapter final : public drivers::SynrmDrive {
     out = fw().window_result();
     return {};
   }
+  double stop_time_s() const override { return t_.synrm_drive().stop_time_s(); }
 
  private:
   firmware::SynrmDriveFirmware& fw() { return t_.synrm_drive(); }

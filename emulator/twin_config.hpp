@@ -18,6 +18,11 @@ enum class LutRotationSpeed { observer, active_flux };  // the rotor speed EEMF-
 inline constexpr std::array<std::string_view, 2> kLutRotationSpeedNames{"observer", "active-flux"};
 enum class EemfErrorSignal { direction, vector };  // the EEMF angle error: direction alone, or the whole vector
 inline constexpr std::array<std::string_view, 2> kEemfErrorSignalNames{"direction", "vector"};
+// What a drive does with the master's disable: the gates off at once (a safe torque off, synbench's
+// own firmware), or the speed ramped to zero first and then the gates off (an SS1-style stop, as
+// many commercial drives do on their run bit; the state reads stopping meanwhile).
+enum class DisableAction { gates_off, ramp };
+inline constexpr std::array<std::string_view, 2> kDisableActionNames{"gates_off", "ramp"};
 
 // Saturated flux linkage of one axis (thesis 1.22, Table 1.2).
 struct FluxAxisParams {
@@ -147,6 +152,12 @@ struct FirmwareParams {
   double undervoltage_trip_V = 300.0;
   double overtemp_trip_C = 120.0;
   drivers::Pwm pwm = drivers::Pwm::capwm;
+  DisableAction disable_action = DisableAction::gates_off;
+  // The drive's documented stop time (its manual's): how long a disable may take to read back
+  // not running. 0 for gates_off; ramp: max_speed_rpm / speed_ramp_rpm_per_s.
+  double stop_time_s() const {
+    return disable_action == DisableAction::ramp ? max_speed_rpm / speed_ramp_rpm_per_s : 0.0;
+  }
 };
 
 // Sensorless estimators (physics.md 8). The EKFs keep the thesis tuning of their own params.

@@ -172,6 +172,9 @@ std::vector<ParamRow> param_table(TwinConfig& c) {
   b.pos("firmware.undervoltage_trip_V", &f.undervoltage_trip_V, "assumed", "under-voltage trip", A);
   b.pos("firmware.overtemp_trip_C", &f.overtemp_trip_C, "assumed", "winding over-temperature trip", A);
   b.choice("firmware.pwm", &f.pwm, drivers::kPwmNames, "Sec. 5.2", "switching scheme at start");
+  b.choice("firmware.disable_action", &f.disable_action, kDisableActionNames, "assumed",
+           "the master's disable: gates off at once (a safe torque off), or ramp: the speed ramped to zero at "
+           "speed_ramp_rpm_per_s first, reading stopping (an SS1-style drive)", A);
 
   auto& h = c.estimators.hfi;
   b.pos("estimators.hfi.voltage_V", &h.voltage_V, "Sec. 6.2.2", "HFI carrier amplitude on the estimated d axis");

@@ -38,6 +38,7 @@ constexpr std::int64_t kMaxMs = 3'600'000;
 
 constexpr int kMinUnitId = 1;
 constexpr int kMaxUnitId = 247;  // 0 is broadcast, 248..255 are reserved
+constexpr std::int64_t kMaxStopTimeMs = 60000;  // a drive that needs longer is not stopping
 
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
@@ -490,7 +491,7 @@ ProfileParseResult parse_device_profile(const synbench::Json& doc) {
   const JsonNode root = read_root(doc, p);
   if (!root.object("a profile must be a JSON object")) return {std::nullopt, std::move(p.errors)};
   root.reject_unknown({"name", "description", "kind", "unit_id", "word_order", "byte_order", "signals", "watchdog",
-                       "meter", "poll_period_ms", "time_base_Hz", "f0_Hz", "kf_Hz_per_A"});
+                       "meter", "poll_period_ms", "time_base_Hz", "f0_Hz", "kf_Hz_per_A", "stop_time_ms"});
 
   DeviceProfile profile;
   profile.name = root["name"].required().text().value_or("");
@@ -517,6 +518,10 @@ ProfileParseResult parse_device_profile(const synbench::Json& doc) {
     }
     check_overlaps(p, profile.signals);
     parse_watchdog(p, doc, profile);
+    if (const JsonNode st = root["stop_time_ms"]; st.present()) {
+      if (*kind == DeviceKind::vfc_meter) st.fail("applies to drives only (a meter has nothing to stop)");
+      else if (const auto ms = st.integer(0, kMaxStopTimeMs)) profile.stop_time_ms = static_cast<std::uint32_t>(*ms);
+    }
     for (const SignalSpec& spec : signal_catalogue(*kind))
       if (spec.required && !signals.has(spec.name))
         signals[spec.name].fail("required signal of kind " + std::string(name(*kind)) + " is missing");

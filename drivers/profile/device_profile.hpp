@@ -123,6 +123,9 @@ struct DeviceProfile {
   double f0_Hz = 0, kf_Hz_per_A = 0;
   // Counter when a heartbeat signal is mapped; else as the profile says (a drive must say).
   WatchdogSpec watchdog;
+  // A drive's documented stop time (its manual's): how long after its disable it may still read
+  // running or stopping, e.g. an SS1-style ramp on the run bit. 0: at once. Drives only.
+  std::uint32_t stop_time_ms = 0;
 
   const ProfileSignal* find(std::string_view signal) const;
 };

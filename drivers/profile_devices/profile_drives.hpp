@@ -80,6 +80,7 @@ class ProfileSynrmDrive final : public SynrmDrive, public ProfileDevice {
   std::string error_detail() const override { return device_error(); }
   // From the profile's types and scales (drivers/frozen_watch.hpp).
   TelemetryResolution resolution() const override;
+  double stop_time_s() const override { return profile().stop_time_ms * 1e-3; }
 
  private:
   std::error_code read_host_window(SynrmWindow& out);
@@ -100,6 +101,7 @@ class ProfileLoadDrive final : public LoadDrive, public ProfileDevice {
   std::error_code read(LoadTelemetry& out) override;
   std::error_code read_window(LoadWindow& out) override;
   std::string error_detail() const override { return device_error(); }
+  double stop_time_s() const override { return profile().stop_time_ms * 1e-3; }
 
  private:
   ReadPlan telemetry_, window_;

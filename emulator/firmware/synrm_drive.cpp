@@ -67,9 +67,20 @@ SynrmDriveFirmware::SynrmDriveFirmware(const TwinConfig& config)
 
 std::error_code SynrmDriveFirmware::enable(bool on) {
   if (!on) {
+    const bool ramps = cfg_.firmware.disable_action == DisableAction::ramp;
+    if (ramps && state_ == drivers::DriveState::running) {
+      // An SS1-style drive: the disable ramps the speed to zero first (stopping), then the gates
+      // go off and the drive reads disabled (control()).
+      state_ = drivers::DriveState::stopping;
+      pending_fault_ = drivers::Fault::none;
+      speed_set_rpm_ = 0.0;
+      return {};
+    }
+    if (ramps && state_ == drivers::DriveState::stopping && pending_fault_ == drivers::Fault::none)
+      return {};  // already ramping down on an earlier disable
     // A disable from the master is obeyed at any time, also during the drive's own ordered
     // stop (as a safe torque off would be): the gates go off and that stop's fault latches.
-    if (state_ == drivers::DriveState::stopping) trip(pending_fault_);
+    if (state_ == drivers::DriveState::stopping) end_stop();
     gates_off();
     if (state_ != drivers::DriveState::faulted) state_ = drivers::DriveState::disabled;
     return {};
@@ -91,7 +102,9 @@ std::error_code SynrmDriveFirmware::enable(bool on) {
 }
 
 std::error_code SynrmDriveFirmware::set_speed_rpm(double speed_rpm) {
-  if (state_ == drivers::DriveState::stopping) return make_error_code(errc::device_fault);
+  // While stopping the drive owns the speed: only the zero it is going to is accepted.
+  if (state_ == drivers::DriveState::stopping)
+    return speed_rpm == 0.0 ? std::error_code{} : make_error_code(errc::device_fault);
   if (!std::isfinite(speed_rpm) || std::fabs(speed_rpm) > cfg_.firmware.max_speed_rpm)
     return make_error_code(errc::invalid_argument);
   if (speed_rpm != speed_set_rpm_) rearm_guard();
@@ -151,9 +164,18 @@ void SynrmDriveFirmware::trip(drivers::Fault fault) {
   gates_off();
 }
 
+double SynrmDriveFirmware::stop_time_s() const { return cfg_.firmware.stop_time_s(); }
+
+void SynrmDriveFirmware::end_stop() {
+  if (pending_fault_ != drivers::Fault::none) return trip(pending_fault_);
+  gates_off();
+  state_ = drivers::DriveState::disabled;  // a disable's ramp, not a fault's stop
+}
+
 void SynrmDriveFirmware::stop_and_latch(drivers::Fault fault) {
   if (state_ != drivers::DriveState::running) {
     if (state_ != drivers::DriveState::stopping) trip(fault);
+    else if (pending_fault_ == drivers::Fault::none) pending_fault_ = fault;  // a disable's ramp goes on, latching
     return;
   }
   state_ = drivers::DriveState::stopping;
@@ -245,7 +267,7 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
   double u_est_alpha = 0, u_est_beta = 0;  // the estimators' view of the applied voltage
   if (state_ == drivers::DriveState::stopping && std::fabs(speed_rpm) < kStoppedRpm &&
       std::fabs(speed_ref_rpm_) < kStoppedRpm)
-    trip(pending_fault_);
+    end_stop();
   if (state_ == drivers::DriveState::running || state_ == drivers::DriveState::stopping) {
     // Speed loop at its own rate, on a ramped reference; held at zero current while the
     // estimator is still finding the rotor (the reference ramp waits with it).

@@ -60,6 +60,8 @@ class SynrmDriveFirmware {
   // Ordered stop on the drive's own initiative (watchdog): ramps the speed to zero under control,
   // then gates off and latches `fault`. State `stopping` until then; commands are refused.
   void stop_and_latch(drivers::Fault fault);
+  // The documented stop time of the drive's disable (FirmwareParams::stop_time_s).
+  double stop_time_s() const;
 
   DriveOutput control(const DriveSample& sample);
 
@@ -95,6 +97,8 @@ class SynrmDriveFirmware {
   drivers::DriveState state_ = drivers::DriveState::disabled;
   drivers::Fault fault_ = drivers::Fault::none;
   drivers::Fault pending_fault_ = drivers::Fault::none;  // latched when the ordered stop ends
+  // The end of a stop: the pending fault latched, or (a disable's ramp) disabled.
+  void end_stop();
   drivers::Pwm pwm_;
   double speed_set_rpm_ = 0, speed_ref_rpm_ = 0, angle_rad_ = 0.0, angle_set_rad_ = 0.0;
   bool rearm_pending_ = false;  // a changed setpoint re-arms the lock guard once reached

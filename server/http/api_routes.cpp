@@ -219,10 +219,11 @@ void add_api_routes(Router& router, ApiContext ctx) {
   // an operator); who pressed it, token id and role, goes into the trip, its event and the log.
   router.add({"POST", "/api/bench/estop", Role::viewer,
               "E-stop (any signed-in role): ahead of every queued command, heartbeats stopped, both drives disabled at "
-              "once (one request each), then read back and the disable repeated every tick until both read stopped; "
-              "the held speed and load setpoints are zeroed; latched until reset. Answers once both disables were "
+              "once (one request each), then read back and the disable repeated until both read stopped (a lost one every "
+              "tick, an acknowledged one at most every 0.1 s; a drive ramping down within its documented stop time is "
+              "left to it); the held speed and load setpoints are zeroed; latched until reset. Answers once both disables were "
               "tried, with the status: supervisor.disable says per drive whether it was acknowledged, is being "
-              "repeated (and why) or is confirmed; the trip's detail names who pressed it.",
+              "repeated (and why), is stopping within its stop time or is confirmed; the trip's detail names who pressed it.",
               AsyncHandler([bench](const Request& req, Reply reply) {
                 bench->estop("E-stop by " + (req.caller_id.empty() ? std::string("an unnamed token") : req.caller_id) + " (" +
                                  role_name(req.caller) + ")",

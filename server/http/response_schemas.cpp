@@ -36,7 +36,7 @@ synbench::Json nullable(synbench::Json s) {
 // disable_json()'s object: null until a stop's disable was sent.
 synbench::Json disable_schema() {
   const synbench::Json drive = closed_object(
-      {{"state", {{"type", "string"}, {"enum", {"acknowledged", "repeating", "confirmed"}}}},
+      {{"state", {{"type", "string"}, {"enum", {"acknowledged", "repeating", "confirmed", "stopping"}}}},
        {"first_acknowledged", kBool},
        {"attempts", kInt},
        {"error", nullable(kStr)},

@@ -146,7 +146,9 @@ struct Recorded {
   double value, t, shaft_rpm, load_Nm;
 };
 struct RecordingBench {
-  emulator::TwinBench bench{emulator::TwinConfig{}};
+  explicit RecordingBench(const emulator::TwinConfig& config = {}) : bench(config) {}
+  emulator::TwinBench bench;
+  double synrm_stop_time_s = 0;  // the SynRM drive's documented stop time, as a profile gives it
   std::vector<Recorded> log;
   double t = 0;
   bool ignore_synrm_disable = false;
@@ -184,6 +186,7 @@ struct RecordingBench {
       return d.read(out);
     }
     std::error_code read_window(drivers::SynrmWindow& out) override { return d.read_window(out); }
+    double stop_time_s() const override { return r.synrm_stop_time_s; }
   } synrm{*this, *bench.devices().synrm};
   struct Load final : drivers::LoadDrive {
     RecordingBench& r;
@@ -274,9 +277,10 @@ TEST(SafetySupervisor, TheOrderedStopTakesTheLoadThenTheSpeedThenDisables) {
   EXPECT_FALSE(r.sup.confirming_stop());
 }
 
-// A drive that does not obey its disable (or whose disable was lost) is not taken for stopped:
-// the disable is repeated every tick, the alarm latches after stop_confirm_s, and no reset hides
-// it while the drive still runs. Once the drive obeys, the reset clears the alarm.
+// A drive that does not obey its disable is not taken for stopped: the disable it acknowledged is
+// repeated at a bounded rate (every kDisableRepeat_s, not every tick: it only loads the line), the
+// alarm latches after stop_confirm_s, and no reset hides it while the drive still runs. Once the
+// drive obeys, the reset clears the alarm.
 TEST(SafetySupervisor, ADriveThatIgnoresItsDisableRaisesTheAlarm) {
   RecordingBench r;
   r.start(500, 1.0);
@@ -288,18 +292,66 @@ TEST(SafetySupervisor, ADriveThatIgnoresItsDisableRaisesTheAlarm) {
   ASSERT_TRUE(r.sup.alarm());
   EXPECT_NE(r.sup.alarm()->detail.find("SynRM drive still reports running"), std::string::npos) << r.sup.alarm()->detail;
   EXPECT_EQ(r.sup.alarm()->detail.find("load drive"), std::string::npos) << "the load obeyed";
-  EXPECT_GE(r.synrm_disables, 30) << "the disable is repeated every tick";
+  EXPECT_GE(r.synrm_disables, 4) << "the disable is repeated";
+  EXPECT_LE(r.synrm_disables, 6) << "at most every " << kDisableRepeat_s << " s in 0.4 s, not every tick";
+  EXPECT_EQ(r.sup.disable_report()->synrm.state, DisableState::repeating);
+  EXPECT_EQ(r.sup.disable_report()->synrm.error, "still reports running");
   bool alarm_event = false;
   for (const auto& [k, m] : r.events) alarm_event = alarm_event || (k == "alarm" && m.find("ALARM") == 0);
   EXPECT_TRUE(alarm_event);
   EXPECT_EQ(r.sup.reset(), make_error_code(errc::busy));
   EXPECT_TRUE(r.sup.tripped());
   r.ignore_synrm_disable = false;
-  r.run_until(r.t + 0.05);
+  r.run_until(r.t + kDisableRepeat_s + 0.03);  // the next repeat goes through
   EXPECT_FALSE(r.sup.confirming_stop());
   EXPECT_FALSE(r.sup.reset());
   EXPECT_FALSE(r.sup.alarm());
   EXPECT_FALSE(r.sup.tripped());
+}
+
+// A drive that ramps down on its disable (an SS1-style stop: the twin's firmware.disable_action
+// "ramp", reading stopping) after an E-stop at 1000 rpm. With its documented stop time (what a
+// profile's stop_time_ms gives) the supervisor leaves it to its ramp: one disable request, state
+// stopping, no alarm, confirmed once it reads disabled about 1 s later (1000 rpm at 1000 rpm/s).
+// Without it, the alarm latches after stop_confirm_s and the repeats come at the bounded rate.
+TEST(SafetySupervisor, ADriveRampingDownWithinItsStopTimeIsLeftToItsRamp) {
+  emulator::TwinConfig c;
+  c.firmware.disable_action = emulator::DisableAction::ramp;
+  ASSERT_DOUBLE_EQ(c.firmware.stop_time_s(), 1.5) << "1500 rpm at 1000 rpm/s";
+  for (const bool documented : {true, false}) {
+    SCOPED_TRACE(documented ? "stop time documented" : "no stop time");
+    RecordingBench r(c);
+    r.synrm_stop_time_s = documented ? c.firmware.stop_time_s() : 0.0;
+    r.start(1000, 1.0);
+    const double t0 = r.t;
+    r.sup.estop(t0, "test");
+    r.run_until(t0 + 0.2);
+    ASSERT_TRUE(r.sup.disable_report());
+    EXPECT_EQ(r.sup.disable_report()->synrm.state, DisableState::stopping) << r.sup.disable_report()->synrm.error;
+    EXPECT_EQ(r.bench.twin().synrm_drive().state(), drivers::DriveState::stopping);
+    r.run_until(t0 + 0.5);
+    // The far side: the shaft follows the drive's ramp, not a coast (the load let go at once).
+    EXPECT_NEAR(r.bench.twin().snapshot().speed_rpm, 500.0, 120.0);
+    r.run_until(t0 + 2.5);
+    const DisableReport& d = *r.sup.disable_report();
+    EXPECT_EQ(d.synrm.state, DisableState::confirmed);
+    ASSERT_TRUE(d.synrm.confirmed_s);
+    EXPECT_NEAR(*d.synrm.confirmed_s - t0, 1.0, 0.25) << "read back disabled at the end of the ramp";
+    EXPECT_EQ(r.bench.twin().synrm_drive().state(), drivers::DriveState::disabled) << "a disable's ramp latches no fault";
+    EXPECT_FALSE(r.sup.confirming_stop());
+    if (documented) {
+      EXPECT_FALSE(r.sup.alarm()) << r.sup.alarm()->detail;
+      EXPECT_EQ(r.synrm_disables, 1) << "a drive ramping within its stop time is not sent its disable again";
+      EXPECT_TRUE(d.synrm.setpoint_zeroed) << "the zero speed the drive ramps to is accepted while stopping";
+    } else {
+      ASSERT_TRUE(r.sup.alarm());
+      EXPECT_NEAR(r.sup.alarm()->at_s - t0, 0.3, 0.02);
+      EXPECT_NE(r.sup.alarm()->detail.find("the SynRM drive still reports stopping"), std::string::npos) << r.sup.alarm()->detail;
+      EXPECT_GE(r.synrm_disables, 5);
+      EXPECT_LE(r.synrm_disables, 10) << "repeated at most every " << kDisableRepeat_s << " s over the 0.7 s past the deadline";
+      EXPECT_FALSE(r.sup.reset()) << "both read back stopped: the reset clears the alarm";
+    }
+  }
 }
 
 // An E-stop whose SynRM disable is lost on the link: the load's is sent all the same, each once,

@@ -160,6 +160,13 @@ const std::vector<InvalidCase> kInvalid = {
      "must exceed period_ms (100)"},
     {"heartbeat_without_period", DeviceKind::load_drive,
      [](json& d) { d["signals"]["heartbeat"].erase("period_ms"); }, "/signals/heartbeat/period_ms", "required"},
+    // A drive's documented stop time (the safety supervisor waits for its ramp that long).
+    {"stop_time_on_a_meter", DeviceKind::vfc_meter, [](json& d) { d["stop_time_ms"] = 100; }, "/stop_time_ms",
+     "applies to drives only"},
+    {"stop_time_above_a_minute", DeviceKind::synrm_drive, [](json& d) { d["stop_time_ms"] = 60001; }, "/stop_time_ms",
+     "60001 is outside 0..60000"},
+    {"stop_time_in_seconds", DeviceKind::load_drive, [](json& d) { d["stop_time_ms"] = 1.5; }, "/stop_time_ms",
+     "must be an integer"},
     {"period_on_another_signal", DeviceKind::vfc_meter, [](json& d) { d["signals"]["gate_s"]["period_ms"] = 100; },
      "/signals/gate_s/period_ms", "heartbeat signal only"},
     // Array signals ("count"): the catalogue's batch arrays need one, any other signal refuses it.
@@ -241,6 +248,18 @@ json minimal_meter() {
       "idcg_A":         { "register": "input", "address": 5, "type": "f32" }
     }
   })");
+}
+
+// A drive's documented stop time reaches the device the safety supervisor asks.
+TEST(DeviceProfile, AStopTimeIsTheDrivesDocumentedOne) {
+  json doc = default_doc(DeviceKind::synrm_drive);
+  ProfileParseResult r = parse_device_profile(doc);
+  ASSERT_TRUE(r.profile) << describe(r.errors);
+  EXPECT_EQ(r.profile->stop_time_ms, 0u) << "synbench's firmware stops at once";
+  doc["stop_time_ms"] = 2500;
+  r = parse_device_profile(doc);
+  ASSERT_TRUE(r.profile) << describe(r.errors);
+  EXPECT_EQ(r.profile->stop_time_ms, 2500u);
 }
 
 TEST(DeviceProfile, DefaultsOfAMinimalProfile) {

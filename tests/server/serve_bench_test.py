@@ -33,7 +33,10 @@ the daemon for a fraction of a second); the E-stop deadline, 1 s, stays well ins
 drive the watchdog stopped reads faulted, not disabled: a drive reading disabled within the
 deadline was disabled by the daemon.
 
-usage: serve_bench_test.py path/to/synbench [tcp|rtu|cli|slow|cut ...]
+Then `ramp`: an E-stop on a drive that ramps down on its disable, with and without its documented
+stop time in its profile (run_ramp).
+
+usage: serve_bench_test.py path/to/synbench [tcp|rtu|cli|slow|cut|ramp ...]
 Exit 77 (skipped) without socat (scripts/debian-packages.txt), 1 on any failure. Standard
 library only: the Modbus master is far_side.py's, not mbpoll (a process per read is too slow to
 time an E-stop).
@@ -53,7 +56,7 @@ from checks import Checks  # noqa: E402
 from daemon import Daemon, PendingRequest, wait_for  # noqa: E402
 
 BIN = sys.argv[1]
-LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow", "cut"]
+LINKS = sys.argv[2:] or ["tcp", "rtu", "cli", "slow", "cut", "ramp"]
 WATCHDOG_MS = 3000
 ESTOP_DEADLINE_S = 1.0    # the issue's bound: request sent -> both drives read disabled
 STAY_S = 2.0              # and they stay disabled this long
@@ -396,6 +399,77 @@ def run_cut(tmp):
         pair.stop()
 
 
+def run_ramp(tmp):
+    """A SynRM drive that ramps down on its disable (an SS1-style stop: the twin's
+    firmware.disable_action "ramp", 1000 rpm/s, reading stopping meanwhile) stopped by an E-stop at
+    1000 rpm. With the drive's documented stop time in its profile (stop_time_ms 1500) the daemon
+    leaves it to its ramp: one disable request, no alarm, and the far side reads the state
+    stopping and the speed falling along the ramp, then disabled, not faulted, about 1 s later.
+    Without it (the default profile) the same stop raises the alarm after 0.3 s, and the disable
+    is repeated at most every 0.1 s, not every tick (about 170 requests in 1.4 s before)."""
+    print("--- an E-stop on a drive that ramps down on its disable")
+    twin_cfg = os.path.join(tmp, "ramp_twin.json")
+    with open(twin_cfg, "w") as f:
+        json.dump({"firmware": {"disable_action": "ramp"}}, f)
+    profiles = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "drivers", "profiles")
+    profile = json.load(open(os.path.join(profiles, "synrm_drive.json")))
+    profile["stop_time_ms"] = 1500
+    with open(os.path.join(tmp, "ramp_synrm.json"), "w") as f:
+        json.dump(profile, f)
+    emu = fs.Emulator(BIN, os.path.join(tmp, "ramp_emulate.log"),
+                      args=["--config", twin_cfg, "--watchdog-timeout-ms", str(WATCHDOG_MS), "--duration-s", "900"])
+    far = fs.ModbusTcp(emu.port)
+    try:
+        for documented in (True, False):
+            label = "ramp (stop_time_ms 1500)" if documented else "ramp (no stop time)"
+            cfg = fs.write_bench_config(os.path.join(tmp, "ramp_bench.json"), fs.tcp_link(emu.port))
+            if documented:
+                bench = json.load(open(cfg))
+                bench["devices"]["synrm_drive"]["profile"] = os.path.join(tmp, "ramp_synrm.json")
+                json.dump(bench, open(cfg, "w"))
+            serve = Daemon(BIN, os.path.join(tmp, "ramp_data_%d" % documented), ["--bench", cfg],
+                           log_path=os.path.join(tmp, "ramp_serve_%d.log" % documented), start_timeout_s=SLOW_S)
+            try:
+                # The first round's drives tripped their watchdog after the daemon stopped: reset.
+                wait_for(lambda: serve.request("POST", "/api/bench/reset")[0] == 200
+                         and far.states() == ((fs.DISABLED, 0), (fs.DISABLED, 0)), 10.0, 0.2)
+                serve.request("POST", "/api/bench/setpoints", {"speed_rpm": 1000, "load_Nm": 1.0, "angle_deg": ANGLE})
+                status, _ = serve.request("POST", "/api/bench/enable", {"enabled": True})
+                spun = wait_for(lambda: running_at(far, 1000, 50), SLOW_S, 0.1)
+                check(status == 200 and spun, "%s: the drives run at 1000 rpm: %s" % (label, fs.describe(far.states())))
+                t0 = time.monotonic()
+                status, _ = serve.request("POST", "/api/bench/estop")
+                samples = []  # (s after the E-stop, SynRM state, fault, speed) from the far side
+                while time.monotonic() - t0 < 2.0:
+                    (state, fault), _ = far.states()
+                    samples.append((time.monotonic() - t0, state, fault, far.speed_rpm()))
+                    time.sleep(0.02)
+                st = serve.request("GET", "/api/bench/status")[1]["supervisor"]
+                d, alarm = st["disable"], st["alarm"]
+                stopping = [s for s in samples if s[1] == fs.STOPPING]
+                at_half = min(samples, key=lambda s: abs(s[0] - 0.5))
+                off = next((s for s in samples if s[1] == fs.DISABLED), None)
+                check(status == 200 and stopping, "%s: the far side reads the SynRM stopping after the E-stop (%d samples)"
+                      % (label, len(stopping)))
+                check(300 < at_half[3] < 700, "%s: its speed follows the ramp: %.0f rpm at %.2f s" % (label, at_half[3], at_half[0]))
+                check(off is not None and 0.7 < off[0] < 1.5 and off[2] == 0,
+                      "%s: then it reads disabled, fault none: %s" % (label, off))
+                if documented:
+                    check(alarm is None, "%s: no alarm (%s)" % (label, alarm))
+                    check(d["synrm"]["attempts"] == 1 and d["synrm"]["state"] == "confirmed" and d["confirmed"],
+                          "%s: one disable request, confirmed (%s)" % (label, d["synrm"]))
+                else:
+                    check(alarm is not None and "SynRM drive still reports stopping" in alarm["detail"],
+                          "%s: the alarm names the drive (%s)" % (label, alarm))
+                    check(2 <= d["synrm"]["attempts"] <= 16,
+                          "%s: the disable repeated at a bounded rate: %d requests" % (label, d["synrm"]["attempts"]))
+            finally:
+                serve.stop()
+    finally:
+        far.close()
+        emu.stop()
+
+
 def run(*args, timeout=180):
     p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=timeout)
     return p.returncode, p.stdout, p.stderr
@@ -504,7 +578,7 @@ def main():
     try:
         for kind in LINKS:
             try:
-                {"cli": run_cli, "slow": run_slow, "cut": run_cut}.get(kind, lambda t: run_link(kind, t))(tmp)
+                {"cli": run_cli, "slow": run_slow, "cut": run_cut, "ramp": run_ramp}.get(kind, lambda t: run_link(kind, t))(tmp)
             except (RuntimeError, OSError, fs.ModbusError) as e:
                 check(False, "%s: %s" % (kind, e))
     finally:

@@ -5,7 +5,8 @@ PostgreSQL cluster, tests/db/pg_cluster.sh), one of them killed with
 SIGKILL mid-sample and re-run, ends with every sample complete, no point stored twice, and the
 same merged analysis as an unkilled single-process run; `status` counts the shards; the
 Kubernetes Indexed Job and Slurm array scripts parse and the command lines they run are accepted
-(with --dry-run) and give each shard its own samples.
+(with --dry-run) and give each shard its own samples (tests/deploy/slurm_test.py runs the Slurm
+script on a real one-node Slurm).
 
 Usage: study_test.py SYNBENCH [SOURCE_DIR]"""
 import glob
@@ -20,6 +21,7 @@ import tempfile
 import time
 
 from checks import Checks
+from study_compare import PLAN, POINTS_PER_SAMPLE, SAMPLES, cells, compare
 
 BIN = sys.argv[1]
 SRC = sys.argv[2] if len(sys.argv) > 2 else os.path.join(os.path.dirname(__file__), "..", "..")
@@ -39,16 +41,6 @@ def study(*args, timeout=600):
     return p.returncode, p.stdout, p.stderr
 
 
-# 4 Ld values x 2 Rs values = 8 samples of 2 configurations x 3 angles = 48 points.
-PLAN = {
-    "name": "ld-rs",
-    "sweep": {"name": "s", "window_s": 0.2, "thermal": {"enabled": False},
-              "dimensions": {"speed_rpm": [700], "load_Nm": [1.0], "angle_deg": [50, 56, 62],
-                             "configurations": [{"estimator": "encoder", "pwm": "capwm"},
-                                                {"estimator": "eemf-lut", "pwm": "capwm"}]}},
-    "grid": {"ld_pct": [-25, -10, 0, 25], "rs_pct": [0, 20]},
-}
-SAMPLES, POINTS_PER_SAMPLE = 8, 6
 plan = write("study.json", PLAN)
 
 # --- refusals ---
@@ -178,32 +170,7 @@ def sharded_study(db, label):
     sharded = json.load(open(os.path.join(tmp, label + ".json")))
 
 
-    def cells(a):
-        out = {}
-        for p in a["parameters"]:
-            for g in p["groups"]:
-                for c in g["configurations"]:
-                    out[(p["parameter"], g["from"], c["configuration"])] = c
-        return out
-
-
-    # Samples that were not killed are bit-identical (same twin, same seed); the resumed sample's
-    # points after the kill start from standstill on a fresh twin, so they agree to the noise.
-    chk(sharded["points"] == ref["points"] == SAMPLES * POINTS_PER_SAMPLE, f"merged points ({sharded['points']})")
-    a, b = cells(ref), cells(sharded)
-    chk(a.keys() == b.keys(), "same groups and configurations")
-    tol = {"pos_err_abs_mean_deg": 0.3, "pos_err_abs_max_deg": 3.0, "speed_err_abs_mean_rpm": 3.0,
-           "efficiency_mean": 0.003, "mtpa_angle_mean_deg": 1.0, "mtpa_shift_deg": 1.0}
-    worst = {}
-    for k in a:
-        chk(a[k]["samples"] == b[k]["samples"] and a[k]["points"] == b[k]["points"], f"{k}: same samples and points")
-        for f, t in tol.items():
-            if a[k][f] is None or b[k][f] is None:
-                chk(a[k][f] is None and b[k][f] is None, f"{k} {f}: both null")
-                continue
-            worst[f] = max(worst.get(f, 0), abs(a[k][f] - b[k][f]))
-    for f, t in tol.items():
-        chk(worst.get(f, 0) <= t, f"merged {f} matches the unkilled run within {t} (worst {worst.get(f, 0):.4g})")
+    compare(chk, ref, sharded, label)
 
     # The sensitivity shows: EEMF-LUT's position error grows with |Ld deviation|.
     ld = {g["from"]: next(c for c in g["configurations"] if c["configuration"] == "eemf-lut/capwm")
@@ -211,8 +178,6 @@ def sharded_study(db, label):
     chk(ld[-25]["pos_err_abs_mean_deg"] > ld[0]["pos_err_abs_mean_deg"] + 0.5,
           f"EEMF-LUT |position error| at Ld -25 % ({ld[-25]['pos_err_abs_mean_deg']:.2f}) above nominal "
           f"({ld[0]['pos_err_abs_mean_deg']:.2f})")
-
-
 
 
 sharded_study(os.path.join(tmp, "shared.db"), "sqlite")
@@ -259,12 +224,19 @@ if job:
 
 p = subprocess.run(["bash", "-n", array_path], capture_output=True, text=True)
 check(p.returncode == 0, f"slurm: the script parses ({p.stderr.strip()})")
-envs = dict(os.environ, SLURM_ARRAY_TASK_ID="3", SLURM_ARRAY_TASK_COUNT="4", SLURM_ARRAY_TASK_MIN="0",
+envs = dict(os.environ, SLURM_ARRAY_TASK_ID="3", SLURM_ARRAY_TASK_COUNT="1", SLURM_ARRAY_TASK_MIN="3",
             SYNBENCH=BIN, SYNBENCH_DB=os.path.join(tmp, "slurm.db"), SYNBENCH_STUDY_FLAGS="--dry-run")
-p = subprocess.run(["bash", array_path, plan], capture_output=True, text=True, env=envs, timeout=60)
+# As in a re-run of task 3 alone (`sbatch --array=3 ...`): the array has one task, the shard is
+# still 3 of the submitted 4. A real Slurm runs the whole sequence in tests/deploy/slurm_test.py.
+p = subprocess.run(["bash", array_path, plan, "4"], capture_output=True, text=True, env=envs, timeout=60)
 check(p.returncode == 0 and "shard 3/4" in p.stdout and re.search(r"/7 ", p.stdout),
-      f"slurm: task 3 of 4 runs shard 3/4 (samples 3, 7) ({p.returncode}, {p.stdout.strip()} {p.stderr.strip()})")
-p = subprocess.run(["bash", array_path, plan], capture_output=True, text=True,
+      f"slurm: task 3 re-run alone runs shard 3/4 (samples 3, 7) ({p.returncode}, {p.stdout.strip()} {p.stderr.strip()})")
+p = subprocess.run(["bash", array_path, plan], capture_output=True, text=True, env=envs, timeout=60)
+check(p.returncode != 0 and "shard count, is required" in p.stderr, f"slurm: N is required ({p.stderr.strip()})")
+p = subprocess.run(["bash", array_path, plan, "3"], capture_output=True, text=True, env=envs, timeout=60)
+check(p.returncode == 2 and "array index 3 is not a shard of 3: submit indices 0..2" in p.stderr,
+      f"slurm: an index outside 0..N-1 is refused ({p.stderr.strip()})")
+p = subprocess.run(["bash", array_path, plan, "4"], capture_output=True, text=True,
                    env={k: v for k, v in envs.items() if not k.startswith("SLURM_")}, timeout=60)
 check(p.returncode != 0 and "SLURM_ARRAY_TASK_ID" in p.stderr, f"slurm: outside an array it says so ({p.stderr.strip()})")
 
