@@ -143,7 +143,7 @@ StudyShardReport run_study_shard(db::Store& store, const bench::StudyPlan& plan,
       continue;
     }
     bool aborted = false;
-    run_to_end(*backend, supervisor, run, bench.poll_period_s, options.interrupted, [&] { aborted = true; });
+    run_to_end(*backend, supervisor, run.engine(), bench.poll_period_s, options.interrupted, [&] { aborted = true; });
     const auto final_state = run.final_state();
     if (auto e = run.finish()) out.error = *e;
     if (out.error.empty()) out.error = run.engine().error();

@@ -5,6 +5,12 @@
 
 namespace synbench::app {
 
+db::EventKind sweep_event_kind(const std::string& kind) {
+  return kind == "fault" || kind == "alarm" ? db::EventKind::fault
+         : kind == "state"                  ? db::EventKind::state
+                                            : db::EventKind::log;
+}
+
 class SweepRun::Sink final : public bench::SweepSink {
  public:
   Sink(db::Store& store, std::int64_t id, bench::SweepSink* observer) : store_(store), id_(id), observer_(observer) {}
@@ -22,10 +28,7 @@ class SweepRun::Sink final : public bench::SweepSink {
     return last_failure_.empty() ? ec.message() : last_failure_;
   }
   void event(const std::string& kind, const std::string& message) override {
-    const auto k = kind == "fault" || kind == "alarm" ? db::EventKind::fault
-                   : kind == "state"                  ? db::EventKind::state
-                                                      : db::EventKind::log;
-    (void)store_.add_event(id_, k, message);
+    (void)store_.add_event(id_, sweep_event_kind(kind), message);
     if (observer_) observer_->event(kind, message);
   }
   void progress(const bench::SweepProgress& p) override {
@@ -75,13 +78,13 @@ std::optional<std::string> SweepRun::finish() {
   return std::nullopt;
 }
 
-double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, SweepRun& run, double tick_s,
+double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, bench::SweepEngine& engine, double tick_s,
                   const std::function<bool()>& interrupted, const std::function<void()>& on_abort) {
   double t = backend.clock().now_s();
   bool abort_sent = false;
-  while (!run.finished()) {
+  while (!engine.finished()) {
     if (!abort_sent && interrupted && interrupted()) {
-      run.engine().abort();
+      engine.abort();
       abort_sent = true;
       if (on_abort) on_abort();
     }
@@ -89,7 +92,7 @@ double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, Sw
     backend.clock().wait_until(t);
     backend.tick(t);
     supervisor.tick(t);
-    run.tick(t);
+    engine.tick(t);
   }
   // However the sweep ended, the drives are read back stopped (or the alarm is raised).
   return confirm_stopped(backend, supervisor, t, tick_s);

@@ -58,11 +58,15 @@ class SweepRun {
   std::unique_ptr<bench::SweepEngine> engine_;
 };
 
+// The store's kind of a sweep event the engine or the supervisor names: "fault" and "alarm" are
+// faults, "state" a state change, anything else a log line.
+db::EventKind sweep_event_kind(const std::string& kind);
+
 // A headless run (`synbench sweep`, `synbench study run`): ticks the bench, the supervisor and the
 // sweep every `tick_s` of the backend's clock until the sweep ends, then confirms both drives read
 // back stopped. `interrupted` is asked every tick; its first true aborts the sweep (ordered stop,
 // resumable) and calls `on_abort`. Returns the time reached.
-double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, SweepRun& run, double tick_s,
+double run_to_end(BenchBackend& backend, bench::SafetySupervisor& supervisor, bench::SweepEngine& engine, double tick_s,
                   const std::function<bool()>& interrupted = {}, const std::function<void()>& on_abort = {});
 
 }  // namespace synbench::app

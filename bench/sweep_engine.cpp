@@ -56,6 +56,20 @@ SweepEngine::SweepEngine(drivers::BenchDevices devices, const SafetySupervisor& 
 
 SweepEngine::~SweepEngine() = default;
 
+void SweepEngine::keep_groups(std::size_t index, std::size_t count) {
+  const auto mine = [&](std::size_t group) { return group % count == index; };
+  std::erase_if(grid_, [&](const PlannedPoint& p) { return !mine(p.group); });
+  std::vector<PlannedGroup> groups;
+  std::vector<AngleSearch> searches;
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    if (!mine(groups_[g].group)) continue;
+    groups.push_back(groups_[g]);
+    searches.push_back(std::move(searches_[g]));
+  }
+  groups_ = std::move(groups);
+  searches_ = std::move(searches);
+}
+
 bool SweepEngine::finished() const {
   return state_ == SweepState::completed || state_ == SweepState::aborted ||
          state_ == SweepState::faulted;

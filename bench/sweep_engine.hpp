@@ -63,6 +63,11 @@ class SweepEngine {
               std::map<std::size_t, PointRecord> stored, SweepSink& sink, SweepBench bench = {});
   ~SweepEngine();
 
+  // Keeps only the groups (PlannedGroup::group) with group % count == index: one of `count`
+  // engines that share the plan's groups out, each on a twin of its own (app/parallel_sweep.hpp).
+  // Before the first tick only.
+  void keep_groups(std::size_t index, std::size_t count);
+
   void tick(double now_s);
   // Pause: finish the point in flight, then hold the bench where it is. Resume continues.
   void pause();

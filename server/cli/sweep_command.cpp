@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <thread>
 #include <unistd.h>
 
 #include "bench/analysis.hpp"
@@ -20,6 +21,7 @@
 #include "db/store.hpp"
 #include "drivers/json_file.hpp"
 #include "app/bench_backend.hpp"
+#include "app/parallel_sweep.hpp"
 #include "app/plan_needs.hpp"
 #include "app/supervised_point.hpp"
 #include "app/sweep_run.hpp"
@@ -48,6 +50,11 @@ options:
   --resume ID         continue sweep ID from the database (its stored plan is used)
   --config FILE       twin config JSON (docs/emulator-config.md)
   --bench FILE        bench config JSON (docs/bench-config.md): its drives instead of the twin
+  --jobs N            twin only: run the plan's groups (the angle sweep at one speed, load and
+                      configuration) on N twins at once, one per core, each from the same config
+                      (default: the machine's cores; 1: one twin, the serial sweep). The points
+                      are written in point order by one writer; each job's twin has its own
+                      noise sequence, so they are not bit-identical to a serial run's
   --bench-name NAME   this bench's name, stored with the sweep next to its host and device
                       profiles' versions (default: the host name; docs/database.md)
   --export-csv FILE   write the sweep's points as CSV when it ends
@@ -149,9 +156,11 @@ int sweep_command(const std::vector<std::string>& argv) {
   std::optional<LoadedBench> loaded;
   std::string bench_file;
   std::string bench_name;
+  std::size_t jobs = std::max(1u, std::thread::hardware_concurrency());
   try {
     Args a(argv, {"--quiet", "--print-committed", "--dry-run", "--help"},
-           {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis", "--bench-name"});
+           {"--db", "--resume", "--config", "--bench", "--export-csv", "--export-json", "--analysis", "--bench-name",
+            "--jobs"});
     if (a.has("--help")) {
       std::cout << kSweepHelp;
       return 0;
@@ -171,6 +180,13 @@ int sweep_command(const std::vector<std::string>& argv) {
       if (!loaded->config.on_twin() && a.text("--config"))
         throw UsageError("--config", "configures the in-process twin, which this bench config does not use; give it to "
                                      "synbench emulate");
+    }
+    if (loaded) jobs = 1;  // a bench has one set of drives
+    if (auto n = a.number("--jobs")) {
+      if (*n < 1 || *n > 256 || *n != std::floor(*n)) throw UsageError("--jobs", "must be a whole number in 1..256");
+      if (loaded && *n > 1)
+        throw UsageError("--jobs", "runs several twins at once; a bench config's drives are one bench (leave --jobs out)");
+      jobs = static_cast<std::size_t>(*n);
     }
     if (auto r = a.number("--resume")) {
       if (*r < 1 || *r != std::floor(*r)) throw UsageError("--resume", "must be a sweep id (a whole number >= 1)");
@@ -273,7 +289,9 @@ int sweep_command(const std::vector<std::string>& argv) {
     }
     id = *created;
   }
-  if (!quiet) std::cerr << "sweep " << id << " (" << store.path().string() << "): " << stored.size() << " points stored before this run\n";
+  if (!quiet)
+    std::cerr << "sweep " << id << " (" << store.path().string() << "): " << stored.size() << " points stored before this run"
+              << (jobs > 1 ? ", " + std::to_string(jobs) + " jobs" : std::string()) << "\n";
 
   auto backend = make_backend(std::move(loaded), config);
   const app::BenchDescription& bench = backend->description();
@@ -281,33 +299,54 @@ int sweep_command(const std::vector<std::string>& argv) {
     std::cerr << "synbench sweep: refused before the start: " << *unmet << "\n";
     return 1;
   }
-  bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [&](const std::string& k, const std::string& m) {
-    (void)store.add_event(id, k == "fault" || k == "alarm" ? db::EventKind::fault : db::EventKind::state, m);
-    if (!quiet && k == "alarm") std::cerr << "ALARM: " << m << "\n";
-  });
   ProgressPrinter printer(id, quiet, print_committed);
-  app::SweepRunOptions run_options;
-  run_options.calibration.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
-  run_options.calibration.uncertainty = bench.uncertainty;
-  run_options.observer = &printer;
-  // The same runner as the daemon's: the stricter of the bench's and the plan's limits.
-  app::SweepRun run(backend->devices(), supervisor, store, id, *plan, std::move(stored), run_options);
-  if (auto e = run.begin()) {
-    std::cerr << "synbench sweep: " << *e << "\n";
-    return 1;
-  }
-
+  bench::SweepBench calibration;
+  calibration.load_b1_Nms_per_rad = bench.load_b1_Nms_per_rad;
+  calibration.uncertainty = bench.uncertainty;
+  const auto on_abort = [&] {
+    if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
+  };
+  db::SweepState final_state = db::SweepState::faulted;
+  std::string engine_error;
+  std::optional<std::string> alarm;
   g_interrupted = false;
   auto previous = std::signal(SIGINT, on_sigint);
-  app::run_to_end(*backend, supervisor, run, bench.poll_period_s, [] { return g_interrupted.load(); }, [&] {
-    if (!quiet) std::cerr << "\ninterrupted: ordered stop, then the sweep can be resumed with --resume " << id << "\n";
-  });
+  if (jobs > 1) {
+    backend.reset();  // each job builds its own twin, on its own thread
+    app::ParallelSweepOptions options;
+    options.jobs = jobs;
+    options.make_backend = [&config] { return make_backend(std::nullopt, config); };
+    options.calibration = calibration;
+    options.observer = &printer;
+    options.interrupted = [] { return g_interrupted.load(); };
+    options.on_abort = on_abort;
+    const auto result = app::run_parallel_sweep(store, id, *plan, stored, options);
+    final_state = result.state;
+    engine_error = result.error;
+    alarm = result.alarm;
+  } else {
+    bench::SafetySupervisor supervisor(backend->devices(), bench.limits, [&](const std::string& k, const std::string& m) {
+      (void)store.add_event(id, app::sweep_event_kind(k), m);
+      if (!quiet && k == "alarm") std::cerr << "ALARM: " << m << "\n";
+    });
+    app::SweepRunOptions run_options;
+    run_options.calibration = calibration;
+    run_options.observer = &printer;
+    // The same runner as the daemon's: the stricter of the bench's and the plan's limits.
+    app::SweepRun run(backend->devices(), supervisor, store, id, *plan, std::move(stored), run_options);
+    if (auto e = run.begin()) {
+      std::signal(SIGINT, previous);
+      std::cerr << "synbench sweep: " << *e << "\n";
+      return 1;
+    }
+    app::run_to_end(*backend, supervisor, run.engine(), bench.poll_period_s, [] { return g_interrupted.load(); }, on_abort);
+    final_state = run.final_state();
+    if (auto e = run.finish()) std::cerr << "synbench sweep: recording the final state: " << *e << "\n";
+    engine_error = run.engine().error();
+    if (supervisor.alarm()) alarm = supervisor.alarm()->detail;
+  }
   std::signal(SIGINT, previous);
   printer.finish_line();
-
-  const auto final_state = run.final_state();
-  if (auto e = run.finish()) std::cerr << "synbench sweep: recording the final state: " << *e << "\n";
-  const std::string engine_error = run.engine().error();
 
   auto rows = store.points(id);
   if (!rows) {
@@ -315,8 +354,8 @@ int sweep_command(const std::vector<std::string>& argv) {
     return 1;
   }
   int status = final_state == db::SweepState::completed ? 0 : final_state == db::SweepState::aborted ? 130 : 1;
-  if (supervisor.alarm()) {
-    std::cerr << "synbench sweep: ALARM: " << supervisor.alarm()->detail << "\n";
+  if (alarm) {
+    std::cerr << "synbench sweep: ALARM: " << *alarm << "\n";
     status = 1;
   }
   if (csv && !write_file(*csv, db::points_to_csv(*rows))) {

@@ -14,20 +14,10 @@
 #include "drivers/json.hpp"
 #include "emulator/plant_deviation.hpp"
 #include "emulator/twin_bench.hpp"
+#include "tests/app/twin_only.hpp"
 
 namespace synbench::app {
 namespace {
-
-class TwinOnly final : public BenchBackend {
- public:
-  explicit TwinOnly(const emulator::TwinConfig& c) : twin_(c) {}
-  drivers::BenchDevices devices() override { return twin_.devices(); }
-  drivers::Clock& clock() override { return twin_.clock(); }
-  synbench::Json describe() const override { return synbench::Json::array(); }
-  const BenchDescription& description() const override { return description_; }
-  emulator::TwinBench twin_;
-  BenchDescription description_;
-};
 
 class CountPoints final : public bench::SweepSink {
  public:
