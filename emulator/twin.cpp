@@ -47,12 +47,17 @@ Twin::Twin(const TwinConfig& config)
 
 Twin::Rates Twin::evaluate(const PlantState& x, double ua, double ub, bool gates, double rs,
                            double load_iref, double p_inv_m, double p_inv_g) const {
-  Rates r;
   const double th = synrm_.pole_pairs() * x.angle_rad;
-  const double c = std::cos(th), s = std::sin(th);
-  const double we = synrm_.pole_pairs() * x.speed_rad_s;
+  return evaluate_at(x, std::cos(th), std::sin(th),
+                     synrm_.flows(x.psi_d_Wb, x.psi_q_Wb, 0.0, 0.0, synrm_.pole_pairs() * x.speed_rad_s, rs), ua, ub,
+                     gates, rs, load_iref, p_inv_m, p_inv_g);
+}
+
+Twin::Rates Twin::evaluate_at(const PlantState& x, double c, double s, SynrmFlows flows, double ua, double ub,
+                              bool gates, double rs, double load_iref, double p_inv_m, double p_inv_g) const {
+  Rates r;
   double ud = c * ua + s * ub, uq = -s * ua + c * ub;
-  r.flows = synrm_.flows(x.psi_d_Wb, x.psi_q_Wb, 0.0, 0.0, we, rs);
+  r.flows = flows;
   if (!gates) {
     ud = -kGatesOffOhm * r.flows.id;
     uq = -kGatesOffOhm * r.flows.iq;
@@ -160,7 +165,7 @@ void Twin::step() {
   const double load_iref = load_fw_.control(x_.load_iq_A + sigma * noise_.gauss());
 
   // Heun: slope at the start, Euler predictor, slope at the end, average.
-  const Rates k1 = evaluate(x_, ua, ub, gates, rs, load_iref_A_, p_inv_m, p_inv_g);
+  const Rates k1 = evaluate_at(x_, c, s, cur, ua, ub, gates, rs, load_iref_A_, p_inv_m, p_inv_g);
   PlantState xp = x_;
   xp.psi_d_Wb += ts_ * k1.dx.psi_d_Wb;
   xp.psi_q_Wb += ts_ * k1.dx.psi_q_Wb;

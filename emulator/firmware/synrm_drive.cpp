@@ -305,8 +305,13 @@ DriveOutput SynrmDriveFirmware::control(const DriveSample& s) {
       rearm_pending_ = false;
     }
     // Motoring and braking both keep i_d positive; the sign of I_m goes to i_q (torque sign).
-    const double id_ref = std::fabs(im_req_A_) * std::cos(angle_rad_);
-    const double iq_ref = im_req_A_ * std::sin(angle_rad_);
+    if (angle_rad_ != angle_trig_rad_) {  // the angle moves only while it slews: a sincos per change
+      angle_trig_rad_ = angle_rad_;
+      angle_cos_ = std::cos(angle_rad_);
+      angle_sin_ = std::sin(angle_rad_);
+    }
+    const double id_ref = std::fabs(im_req_A_) * angle_cos_;
+    const double iq_ref = im_req_A_ * angle_sin_;
     const double wc = 2.0 * kPi * cfg_.firmware.current_bandwidth_Hz;
     id_pi_.set_gains(wc * flux_d_.dynamic_inductance_H(id_ref), wc * rs_nominal_ohm_);
     iq_pi_.set_gains(wc * flux_q_.dynamic_inductance_H(iq_ref), wc * rs_nominal_ohm_);

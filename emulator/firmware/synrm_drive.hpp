@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -97,6 +98,8 @@ class SynrmDriveFirmware {
   drivers::DriveState state_ = drivers::DriveState::disabled;
   drivers::Fault fault_ = drivers::Fault::none;
   drivers::Fault pending_fault_ = drivers::Fault::none;  // latched when the ordered stop ends
+  // cos and sin of angle_rad_, computed when it changes (angle_trig_rad_: the angle they are of).
+  double angle_trig_rad_ = std::numeric_limits<double>::quiet_NaN(), angle_cos_ = 1.0, angle_sin_ = 0.0;
   // The end of a stop: the pending fault latched, or (a disable's ramp) disabled.
   void end_stop();
   drivers::Pwm pwm_;
